@@ -1,0 +1,1 @@
+//! Training set built from BVH folders: features, joints, captions, splits, statistics.

@@ -1,0 +1,1 @@
+//! Motion file formats: BVH import/export, `.npy` joint arrays, `.json`.

@@ -1,0 +1,1 @@
+//! The `.mprog` language: syntax, checking, lowering to a differentiable error.

@@ -1,0 +1,25 @@
+//! mprog: programmable human motion generation.
+//!
+//! A `.mprog` program describes what a motion must satisfy; mprog parses and checks it,
+//! lowers it to a differentiable error on joint positions, and uses that error to steer
+//! a motion diffusion model.
+//!
+//! | stage | module | input → output |
+//! | --- | --- | --- |
+//! | motion data | [`formats`], [`features`], [`dataset`] | BVH / npy → [`motion::Motion`] → 263-dim HumanML3D features → training set |
+//! | model | [`model`] | features + text → denoiser, samplers, training |
+//! | language | [`lang`] | source → AST → checked IR → burn error graph |
+//! | pictures | [`render`] | motions, curves → GIF / PNG |
+//!
+//! Conventions everywhere: HumanML3D 22-joint skeleton ([`skeleton`]), metres, Y up,
+//! 20 fps; tensors of joint positions are `[batch, people, frames, 22, 3]`.
+
+pub mod dataset;
+pub mod features;
+pub mod formats;
+pub mod fsutil;
+pub mod lang;
+pub mod model;
+pub mod motion;
+pub mod render;
+pub mod skeleton;

@@ -1,0 +1,1 @@
+//! The motion diffusion model: denoiser, text encoder, noise schedule, samplers, training.

@@ -1,0 +1,1 @@
+//! Pictures: stick-figure GIF/PNG renders of motions and line plots.
