@@ -1,5 +1,7 @@
 //! The `mprog` command line.
 
+mod cli;
+
 use clap::{Parser, Subcommand};
 
 /// Programmable human motion generation.
@@ -14,21 +16,26 @@ struct Cli {
 enum Command {
     /// Print the joint names and aliases of the skeleton.
     Joints,
+    /// Train the denoiser on a dataset built by `mprog data build`.
+    Train(cli::train::TrainArgs),
 }
 
 fn main() -> miette::Result<()> {
     let cli = Cli::parse();
     match cli.command {
-        Command::Joints => {
-            for (i, name) in mprog::skeleton::JOINT_NAMES.iter().enumerate() {
-                let aliases: Vec<&str> = mprog::skeleton::ALIASES
-                    .iter()
-                    .filter(|(_, j)| *j == i)
-                    .map(|(a, _)| *a)
-                    .collect();
-                println!("{i:2} {name:15} {}", aliases.join(", "));
-            }
-        }
+        Command::Joints => print_joints(),
+        Command::Train(args) => cli::train::run(args)?,
     }
     Ok(())
+}
+
+fn print_joints() {
+    for (i, name) in mprog::skeleton::JOINT_NAMES.iter().enumerate() {
+        let aliases: Vec<&str> = mprog::skeleton::ALIASES
+            .iter()
+            .filter(|(_, j)| *j == i)
+            .map(|(a, _)| *a)
+            .collect();
+        println!("{i:2} {name:15} {}", aliases.join(", "));
+    }
 }

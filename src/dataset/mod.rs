@@ -1,1 +1,11 @@
 //! Training set built from BVH folders: features, joints, captions, splits, statistics.
+//!
+//! [`build::build_dataset`] writes it, [`store::Dataset::load`] reads it back.
+
+// pub mod build; (enabled once formats and features land)
+pub mod captions;
+pub mod split;
+pub mod stats;
+pub mod store;
+
+pub use store::{ClipInfo, Dataset, DatasetError, DatasetIndex, FEATURE_DIM, Split, SplitStats};

@@ -1,0 +1,3 @@
+//! Subcommands of the `mprog` binary, one file each.
+
+pub mod train;

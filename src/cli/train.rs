@@ -1,0 +1,97 @@
+//! `mprog train`: train the denoiser on a built dataset, resumable.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use miette::{IntoDiagnostic, Result, WrapErr, miette};
+use mprog::dataset::Dataset;
+use mprog::model::TrainConfig;
+use mprog::model::train::TrainRun;
+use std::path::PathBuf;
+
+/// Arguments of `mprog train`.
+#[derive(clap::Args)]
+pub struct TrainArgs {
+    /// Training set written by `mprog data build`.
+    #[arg(long)]
+    data: PathBuf,
+    /// Training settings (TOML); ignored when resuming (the run's own copy is used).
+    #[arg(long, default_value = "models/train-default.toml")]
+    config: PathBuf,
+    /// Run folder: checkpoints, loss curves and the exported bundle go here.
+    #[arg(long)]
+    out: PathBuf,
+    /// Continue the run in `--out` from its last checkpoint.
+    #[arg(long)]
+    resume: bool,
+    /// Stop after this many steps in this session (the run can be resumed later).
+    #[arg(long)]
+    steps: Option<usize>,
+}
+
+/// Runs `mprog train`.
+pub fn run(args: TrainArgs) -> Result<()> {
+    let run_config = args.out.join("config.toml");
+    let config: TrainConfig = if args.resume {
+        let text = std::fs::read_to_string(&run_config)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("--resume needs {}", run_config.display()))?;
+        toml::from_str(&text)
+            .into_diagnostic()
+            .wrap_err("bad run config")?
+    } else {
+        if run_config.exists() {
+            return Err(miette!(
+                help = "pass --resume to continue it, or choose another --out",
+                "{} already holds a training run",
+                args.out.display()
+            ));
+        }
+        let text = std::fs::read_to_string(&args.config)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot read {}", args.config.display()))?;
+        let config: TrainConfig = toml::from_str(&text)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("bad training config {}", args.config.display()))?;
+        std::fs::create_dir_all(&args.out).into_diagnostic()?;
+        mprog::fsutil::write_bytes_atomic(
+            &run_config,
+            toml::to_string(&config).into_diagnostic()?.as_bytes(),
+        )
+        .into_diagnostic()?;
+        config
+    };
+    let data = Dataset::load(&args.data).into_diagnostic()?;
+    eprintln!(
+        "training on {} clips ({} train), d_model {}, {} layers, batch {}, crops of {} frames",
+        data.index.clips.len(),
+        data.index.stats[0].clips,
+        config.model.d_model,
+        config.model.layers,
+        config.batch_size,
+        config.crop_frames
+    );
+    let bar = ProgressBar::new(config.steps as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} steps  {msg}  [{elapsed_precise}, eta {eta}]",
+        )
+        .expect("valid template"),
+    );
+    let run = TrainRun {
+        data: &data,
+        config: config.clone(),
+        out: args.out.clone(),
+        max_steps_now: args.steps,
+    };
+    let state = run
+        .run(&|state, loss, lr| {
+            bar.set_position(state.step as u64);
+            bar.set_message(format!("loss {loss:.4}  lr {lr:.1e}"));
+        })
+        .into_diagnostic()?;
+    bar.finish();
+    eprintln!(
+        "stopped at step {} after {:.0} s of training in total; last mean loss {:.4}, val {:?}",
+        state.step, state.seconds, state.recent_loss, state.val_loss
+    );
+    Ok(())
+}

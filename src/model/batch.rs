@@ -1,0 +1,83 @@
+//! Training batches: random clips of the training split, random crops, captions and
+//! timesteps, drawn from a generator seeded by (run seed, step) so a resumed run sees the
+//! same data it would have seen without the interruption.
+
+use super::config::TrainConfig;
+use super::schedule::DIFFUSION_STEPS;
+use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A batch on the host, normalised, padded to the longest crop.
+#[derive(Clone, Debug)]
+pub struct HostBatch {
+    /// `[B, N, 263]` normalised clean features (zeros on padding).
+    pub x0: Vec<f32>,
+    /// `[B, N]` true on padded frames.
+    pub padding: Vec<bool>,
+    /// Frames per sample (N).
+    pub frames: usize,
+    /// One caption per sample.
+    pub captions: Vec<String>,
+    /// Diffusion timestep per sample.
+    pub timesteps: Vec<usize>,
+    /// 1 keeps the caption, 0 drops it (classifier-free guidance training).
+    pub keep_text: Vec<f32>,
+    /// Generator state after drawing the batch (used for the noise).
+    pub noise_seed: u64,
+}
+
+/// Generator for step `step` of a run seeded with `seed`.
+pub fn step_rng(seed: u64, step: usize) -> ChaCha8Rng {
+    ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ step as u64)
+}
+
+/// Draws the batch of `step`.
+pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: usize) -> HostBatch {
+    let mut rng = step_rng(cfg.seed, step);
+    let picks: Vec<(&ClipInfo, usize, usize)> = (0..cfg.batch_size)
+        .map(|_| {
+            let clip = clips[rng.random_range(0..clips.len())];
+            let len = clip.frames.min(cfg.crop_frames);
+            let start = rng.random_range(0..=clip.frames - len);
+            (clip, start, len)
+        })
+        .collect();
+    let frames = picks.iter().map(|p| p.2).max().unwrap_or(1);
+    let b = picks.len();
+    let mut x0 = vec![0.0f32; b * frames * FEATURE_DIM];
+    let mut padding = vec![true; b * frames];
+    let mut captions = Vec::with_capacity(b);
+    for (i, (clip, start, len)) in picks.iter().enumerate() {
+        let rows = &ds.clip_features(clip)[start * FEATURE_DIM..(start + len) * FEATURE_DIM];
+        for (k, row) in rows.chunks_exact(FEATURE_DIM).enumerate() {
+            let dst = &mut x0[(i * frames + k) * FEATURE_DIM..][..FEATURE_DIM];
+            for f in 0..FEATURE_DIM {
+                dst[f] = (row[f] - ds.mean[f]) / ds.std[f];
+            }
+            padding[i * frames + k] = false;
+        }
+        captions.push(clip.captions[rng.random_range(0..clip.captions.len())].clone());
+    }
+    let timesteps = (0..b)
+        .map(|_| rng.random_range(0..DIFFUSION_STEPS))
+        .collect();
+    let keep_text = (0..b)
+        .map(|_| {
+            if rng.random::<f64>() < cfg.cond_drop {
+                0.0
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    HostBatch {
+        x0,
+        padding,
+        frames,
+        captions,
+        timesteps,
+        keep_text,
+        noise_seed: rng.random(),
+    }
+}

@@ -1,0 +1,102 @@
+//! Model and training configuration (TOML files, stored next to weights).
+
+use serde::{Deserialize, Serialize};
+
+/// Shape of the denoiser.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelConfig {
+    /// Feature width of a frame (263 for HumanML3D).
+    #[serde(default = "default_features")]
+    pub features: usize,
+    /// Transformer width.
+    pub d_model: usize,
+    /// Encoder layers.
+    pub layers: usize,
+    /// Attention heads.
+    pub heads: usize,
+    /// Feed-forward width.
+    pub d_ff: usize,
+    /// Dropout in training.
+    #[serde(default = "default_dropout")]
+    pub dropout: f64,
+    /// Width of the word embeddings of the text encoder.
+    pub d_text: usize,
+    /// Longest motion the model is asked for (frames).
+    pub max_frames: usize,
+}
+
+fn default_features() -> usize {
+    263
+}
+fn default_dropout() -> f64 {
+    0.1
+}
+
+impl Default for ModelConfig {
+    fn default() -> Self {
+        ModelConfig {
+            features: 263,
+            d_model: 256,
+            layers: 4,
+            heads: 4,
+            d_ff: 1024,
+            dropout: 0.1,
+            d_text: 128,
+            max_frames: 196,
+        }
+    }
+}
+
+/// Settings of a training run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainConfig {
+    /// Denoiser shape.
+    pub model: ModelConfig,
+    /// Clips per batch.
+    pub batch_size: usize,
+    /// Frames per training crop (clips shorter are padded and masked).
+    pub crop_frames: usize,
+    /// Peak learning rate (AdamW).
+    pub learning_rate: f64,
+    /// Linear warm-up steps.
+    pub warmup_steps: usize,
+    /// AdamW weight decay.
+    pub weight_decay: f64,
+    /// Gradient norm clip.
+    pub grad_clip: f64,
+    /// Probability of dropping the text condition (classifier-free guidance).
+    pub cond_drop: f64,
+    /// EMA decay of the shipped weights.
+    pub ema_decay: f64,
+    /// Total optimisation steps (training can stop and resume before it).
+    pub steps: usize,
+    /// Save a checkpoint every this many steps.
+    pub checkpoint_every: usize,
+    /// Weight of the foot-contact velocity loss on recovered joints (0 disables).
+    #[serde(default)]
+    pub foot_loss: f64,
+    /// Seed of the data order and noise.
+    pub seed: u64,
+}
+
+impl Default for TrainConfig {
+    fn default() -> Self {
+        TrainConfig {
+            model: ModelConfig::default(),
+            batch_size: 32,
+            crop_frames: 120,
+            learning_rate: 2e-4,
+            warmup_steps: 300,
+            weight_decay: 0.0,
+            grad_clip: 1.0,
+            cond_drop: 0.1,
+            ema_decay: 0.999,
+            steps: 100_000,
+            checkpoint_every: 200,
+            foot_loss: 0.0,
+            seed: 1,
+        }
+    }
+}

@@ -1,0 +1,136 @@
+//! Samplers over a [`Denoiser`]: classifier-free guided x̂0, DDIM (η = 0) and ancestral
+//! DDPM steps, and whole chains. Solvers reuse the step functions to insert guidance.
+
+use super::denoiser::{Denoiser, DenoiserInput};
+use super::noise::NoiseSource;
+use super::schedule::NoiseSchedule;
+use super::text::{TokenBatch, Vocabulary};
+use burn::prelude::*;
+
+/// Which chain to run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SamplerKind {
+    /// Deterministic DDIM with this many steps.
+    Ddim(usize),
+    /// Ancestral DDPM with this many (respaced) steps; 1000 = the full chain.
+    Ddpm(usize),
+}
+
+/// The text condition of a batch, tokenised once and reused at every step.
+#[derive(Clone, Debug)]
+pub struct Condition {
+    /// Prompts then the same prompts again (the unconditional half), when guided.
+    pub tokens: TokenBatch,
+    /// Classifier-free guidance scale (1 = plain conditional model).
+    pub guidance_scale: f32,
+    batch: usize,
+}
+
+impl Condition {
+    /// Tokenises `prompts` (one per sample).
+    pub fn new(vocab: &Vocabulary, prompts: &[&str], guidance_scale: f32, device: &Device) -> Self {
+        let doubled: Vec<&str> = if guidance_scale != 1.0 {
+            prompts.iter().chain(prompts.iter()).copied().collect()
+        } else {
+            prompts.to_vec()
+        };
+        Condition {
+            tokens: TokenBatch::new(vocab, &doubled, device),
+            guidance_scale,
+            batch: prompts.len(),
+        }
+    }
+
+    /// Words of each prompt that the model does not know.
+    pub fn unknown_words(&self) -> &[Vec<String>] {
+        &self.tokens.unknown[..self.batch]
+    }
+}
+
+/// x̂0 with classifier-free guidance: uncond + s·(cond − uncond), both passes in one batch.
+pub fn guided_x0(
+    den: &impl Denoiser,
+    x_t: Tensor<3>,
+    timestep: usize,
+    cond: &Condition,
+) -> Tensor<3> {
+    let device = x_t.device();
+    let b = cond.batch;
+    if cond.guidance_scale == 1.0 {
+        let input = DenoiserInput {
+            x_t,
+            timesteps: vec![timestep; b],
+            tokens: cond.tokens.clone(),
+            keep_text: Tensor::ones([b], &device),
+            padding: None,
+        };
+        return den.predict_x0(&input);
+    }
+    let keep: Vec<f32> = (0..2 * b).map(|i| if i < b { 1.0 } else { 0.0 }).collect();
+    let input = DenoiserInput {
+        x_t: Tensor::cat(vec![x_t.clone(), x_t], 0),
+        timesteps: vec![timestep; 2 * b],
+        tokens: cond.tokens.clone(),
+        keep_text: Tensor::from_data(TensorData::new(keep, [2 * b]), &device),
+        padding: None,
+    };
+    let out = den.predict_x0(&input);
+    let c = out.clone().narrow(0, 0, b);
+    let u = out.narrow(0, b, b);
+    u.clone() + (c - u) * cond.guidance_scale
+}
+
+/// One DDIM step (η = 0) from step `i` to `i − 1` given x̂0.
+pub fn ddim_step(s: &NoiseSchedule, i: usize, x_t: Tensor<3>, x0: Tensor<3>) -> Tensor<3> {
+    let a = s.alphas_cumprod[i];
+    let a_prev = s.alpha_cumprod_prev(i);
+    // ε̂ = (x_t/√ᾱ − x̂0)/√(1/ᾱ − 1); x_prev = √ᾱ_prev x̂0 + √(1−ᾱ_prev) ε̂
+    let eps = (x_t * (1.0 / a.sqrt()) - x0.clone()) * (1.0 / (1.0 / a - 1.0).sqrt());
+    x0 * a_prev.sqrt() + eps * (1.0 - a_prev).sqrt()
+}
+
+/// Posterior mean μ(x̂0, x_t) of step `i`.
+pub fn posterior_mean(s: &NoiseSchedule, i: usize, x_t: Tensor<3>, x0: Tensor<3>) -> Tensor<3> {
+    let p = s.posterior(i);
+    x0 * p.coef_x0 + x_t * p.coef_xt
+}
+
+/// Runs a whole chain from the initial noise `x_t` (`[B, N, F]`, normalised space).
+/// `noise` supplies DDPM's per-step noise; DDIM ignores it.
+pub fn sample_chain(
+    den: &impl Denoiser,
+    schedule: &NoiseSchedule,
+    kind: SamplerKind,
+    mut x_t: Tensor<3>,
+    cond: &Condition,
+    noise: &mut NoiseSource,
+    mut on_step: impl FnMut(usize, usize),
+) -> Tensor<3> {
+    let device = x_t.device();
+    let dims = x_t.dims();
+    let n = schedule.len();
+    for i in (0..n).rev() {
+        let x0 = guided_x0(den, x_t.clone(), schedule.timesteps[i], cond);
+        x_t = match kind {
+            SamplerKind::Ddim(_) => ddim_step(schedule, i, x_t, x0),
+            SamplerKind::Ddpm(_) => {
+                let mean = posterior_mean(schedule, i, x_t, x0);
+                if i > 0 {
+                    let sd = schedule.posterior(i).variance.sqrt();
+                    mean + noise.tensor(dims, &device) * sd
+                } else {
+                    mean
+                }
+            }
+        };
+        on_step(n - i, n);
+    }
+    x_t
+}
+
+/// The schedule a sampler kind runs on.
+pub fn schedule_for(base: &NoiseSchedule, kind: SamplerKind) -> NoiseSchedule {
+    match kind {
+        SamplerKind::Ddim(k) | SamplerKind::Ddpm(k) => base.respaced(k),
+    }
+}

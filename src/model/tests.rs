@@ -1,0 +1,193 @@
+//! Model tests on tiny configurations: shapes, weights round trips and mismatches,
+//! determinism of the samplers, and a short training run that learns and resumes.
+
+use super::config::{ModelConfig, TrainConfig};
+use super::denoiser::{Denoiser, DenoiserInput, Mdm};
+use super::noise::NoiseSource;
+use super::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
+use super::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use super::text::{TokenBatch, Vocabulary};
+use super::train::TrainRun;
+use super::weights::{model_from_safetensors, model_to_safetensors};
+use crate::dataset::{ClipInfo, Dataset, DatasetIndex, FEATURE_DIM, Split, SplitStats};
+use burn::prelude::*;
+
+fn tiny() -> ModelConfig {
+    ModelConfig {
+        features: FEATURE_DIM,
+        d_model: 32,
+        layers: 2,
+        heads: 2,
+        d_ff: 64,
+        dropout: 0.1,
+        d_text: 8,
+        max_frames: 40,
+    }
+}
+
+fn vocab() -> Vocabulary {
+    Vocabulary::from_captions(["a person walks forward", "a person waves"], 8)
+}
+
+fn input(b: usize, n: usize, dev: &Device) -> DenoiserInput {
+    let prompts = vec!["a person walks"; b];
+    DenoiserInput {
+        x_t: NoiseSource::new(3).tensor([b, n, FEATURE_DIM], dev),
+        timesteps: vec![500; b],
+        tokens: TokenBatch::new(&vocab(), &prompts, dev),
+        keep_text: Tensor::ones([b], dev),
+        padding: None,
+    }
+}
+
+#[test]
+fn denoiser_keeps_shape_and_ignores_padded_frames() {
+    let dev = Device::flex();
+    let model = Mdm::new(&tiny(), vocab().len(), &dev).valid();
+    let mut inp = input(2, 10, &dev);
+    assert_eq!(model.predict_x0(&inp).dims(), [2, 10, FEATURE_DIM]);
+    // Changing padded frames must not change the prediction of valid frames.
+    let mut pad = vec![false; 20];
+    pad[8..10].fill(true);
+    pad[18..20].fill(true);
+    inp.padding = Some(Tensor::from_data(TensorData::new(pad, [2, 10]), &dev));
+    let a = model.predict_x0(&inp).narrow(1, 0, 8);
+    let noise = NoiseSource::new(9).tensor([2, 2, FEATURE_DIM], &dev);
+    inp.x_t = Tensor::cat(vec![inp.x_t.clone().narrow(1, 0, 8), noise], 1);
+    let b = model.predict_x0(&inp).narrow(1, 0, 8);
+    let diff = (a - b).abs().max().into_scalar::<f32>();
+    assert!(diff < 1e-5, "padded frames leaked into valid ones: {diff}");
+}
+
+#[test]
+fn half_precision_round_trip_is_close_and_wrong_shapes_are_refused() {
+    let dev = Device::flex();
+    let model = Mdm::new(&tiny(), vocab().len(), &dev).valid();
+    let bytes = model_to_safetensors(&model, true).unwrap();
+    let loaded =
+        model_from_safetensors(Mdm::new(&tiny(), vocab().len(), &dev), bytes.clone(), true)
+            .unwrap()
+            .valid();
+    let inp = input(1, 6, &dev);
+    let diff = (model.predict_x0(&inp) - loaded.predict_x0(&inp))
+        .abs()
+        .max()
+        .into_scalar::<f32>();
+    assert!(diff < 2e-2, "f16 round trip error {diff}");
+    let mut other = tiny();
+    other.d_model = 48;
+    let err =
+        model_from_safetensors(Mdm::new(&other, vocab().len(), &dev), bytes, true).unwrap_err();
+    assert!(err.contains("do not fit"), "{err}");
+}
+
+#[test]
+fn ddim_is_deterministic_from_the_seed() {
+    let dev = Device::flex();
+    let model = Mdm::new(&tiny(), vocab().len(), &dev).valid();
+    let base = NoiseSchedule::cosine(DIFFUSION_STEPS);
+    let kind = SamplerKind::Ddim(5);
+    let s = schedule_for(&base, kind);
+    let cond = Condition::new(&vocab(), &["a person walks"], 2.5, &dev);
+    let run = |seed| {
+        let x = NoiseSource::new(seed).tensor([1, 8, FEATURE_DIM], &dev);
+        sample_chain(
+            &model,
+            &s,
+            kind,
+            x,
+            &cond,
+            &mut NoiseSource::new(seed + 1),
+            |_, _| {},
+        )
+        .into_data()
+        .to_vec::<f32>()
+        .unwrap()
+    };
+    assert_eq!(run(1), run(1));
+    assert_ne!(run(1), run(2));
+}
+
+/// A dataset of two synthetic "clips": smooth sinusoids with a caption each.
+fn synthetic_dataset() -> Dataset {
+    let frames = 24;
+    let mut features = Vec::new();
+    for c in 0..2 {
+        for t in 0..frames {
+            for f in 0..FEATURE_DIM {
+                features.push(((t as f32 * 0.3 + f as f32 * 0.1) * (c + 1) as f32).sin());
+            }
+        }
+    }
+    let clip = |i: usize, caption: &str| ClipInfo {
+        name: format!("c{i}"),
+        source: format!("c{i}.bvh"),
+        content: "walk".into(),
+        style: "normal".into(),
+        mirrored: false,
+        split: if i == 0 { Split::Train } else { Split::Val },
+        offset: i * frames,
+        frames,
+        captions: vec![caption.into()],
+    };
+    Dataset {
+        index: DatasetIndex {
+            version: 1,
+            fps: 20.0,
+            clips: vec![clip(0, "a person walks forward"), clip(1, "a person waves")],
+            stats: [
+                SplitStats::default(),
+                SplitStats::default(),
+                SplitStats::default(),
+            ],
+            skipped: vec![],
+            build_seconds: 0.0,
+        },
+        joints: vec![0.0; 2 * frames * 66],
+        features,
+        mean: vec![0.0; FEATURE_DIM],
+        std: vec![1.0; FEATURE_DIM],
+    }
+}
+
+#[test]
+fn training_learns_and_resumes_from_checkpoints() {
+    let data = synthetic_dataset();
+    let dir = tempfile::tempdir().unwrap();
+    let config = TrainConfig {
+        model: tiny(),
+        batch_size: 4,
+        crop_frames: 16,
+        learning_rate: 3e-3,
+        warmup_steps: 1,
+        checkpoint_every: 10,
+        steps: 60,
+        ..TrainConfig::default()
+    };
+    let run = |steps| TrainRun {
+        data: &data,
+        config: config.clone(),
+        out: dir.path().to_path_buf(),
+        max_steps_now: Some(steps),
+    };
+    let first = run(30).run(&|_, _, _| {}).unwrap();
+    assert_eq!(first.step, 30);
+    assert!(dir.path().join("ckpt/state.json").exists());
+    assert!(dir.path().join("bundle/model.safetensors").exists());
+    let second = run(30).run(&|_, _, _| {}).unwrap();
+    assert_eq!(second.step, 60, "resumed from step 30");
+    let csv = std::fs::read_to_string(dir.path().join("loss.csv")).unwrap();
+    let losses: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(losses.len(), 60);
+    let early: f64 = losses[..10].iter().sum::<f64>() / 10.0;
+    let late: f64 = losses[50..].iter().sum::<f64>() / 10.0;
+    assert!(late < 0.7 * early, "loss did not fall: {early} -> {late}");
+    // The exported bundle loads.
+    let bundle =
+        super::weights::ModelBundle::load(&dir.path().join("bundle"), &Device::flex()).unwrap();
+    assert_eq!(bundle.manifest.steps, 60);
+}

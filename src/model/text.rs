@@ -1,0 +1,188 @@
+//! Text conditioning: a vocabulary built from the training captions and a small word
+//! encoder trained with the denoiser (mean of learned word embeddings).
+//!
+//! The encoder sits behind [`TextEncoder`] so a pretrained sentence encoder can replace
+//! it. Words outside the vocabulary are dropped and reported, never an error: a prompt
+//! with unseen words still generates.
+
+use burn::nn::{Embedding, EmbeddingConfig};
+use burn::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Token id reserved for padding (and for prompts with no known word).
+pub const PAD: usize = 0;
+
+/// Words seen in the training captions, with stable ids (1..).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Vocabulary {
+    /// Word → id; ids start at 1.
+    pub words: BTreeMap<String, usize>,
+    /// Longest token sequence fed to the encoder.
+    pub max_tokens: usize,
+}
+
+/// Lower-cases and splits a caption into words (letters, digits and apostrophes).
+pub fn words_of(text: &str) -> Vec<String> {
+    text.split(|c: char| !(c.is_alphanumeric() || c == '\''))
+        .filter(|w| !w.is_empty())
+        .map(|w| w.to_lowercase())
+        .collect()
+}
+
+/// Function words that carry no motion meaning; kept out of the vocabulary so they
+/// neither dilute the mean embedding nor show up as "ignored".
+const STOP_WORDS: &[&str] = &[
+    "a", "an", "the", "is", "are", "and", "in", "of", "to", "way", "manner", "while", "their",
+    "his", "her", "with",
+];
+
+impl Vocabulary {
+    /// Builds the vocabulary from every caption (sorted, so ids are deterministic).
+    pub fn from_captions<'a>(
+        captions: impl IntoIterator<Item = &'a str>,
+        max_tokens: usize,
+    ) -> Self {
+        let mut set: Vec<String> = captions
+            .into_iter()
+            .flat_map(words_of)
+            .filter(|w| !STOP_WORDS.contains(&w.as_str()))
+            .collect();
+        set.sort();
+        set.dedup();
+        let words = set
+            .into_iter()
+            .enumerate()
+            .map(|(i, w)| (w, i + 1))
+            .collect();
+        Vocabulary { words, max_tokens }
+    }
+
+    /// Size including the padding id.
+    pub fn len(&self) -> usize {
+        self.words.len() + 1
+    }
+
+    /// True when no word is known.
+    pub fn is_empty(&self) -> bool {
+        self.words.is_empty()
+    }
+
+    /// Token ids of a prompt, and the words it did not know (stop words are silently
+    /// skipped; they are not "unknown").
+    pub fn tokenize(&self, text: &str) -> (Vec<usize>, Vec<String>) {
+        let mut ids = Vec::new();
+        let mut unknown = Vec::new();
+        for w in words_of(text) {
+            match self.words.get(&w) {
+                Some(&id) => ids.push(id),
+                None if STOP_WORDS.contains(&w.as_str()) => {}
+                None => unknown.push(w),
+            }
+        }
+        ids.truncate(self.max_tokens);
+        (ids, unknown)
+    }
+}
+
+/// Token ids of a batch of prompts, padded: `[B, L]` ids and a `[B, L]` 0/1 mask.
+#[derive(Clone, Debug)]
+pub struct TokenBatch {
+    /// `[B, L]` token ids.
+    pub ids: Tensor<2, Int>,
+    /// `[B, L]` 1.0 for a real token, 0.0 for padding.
+    pub mask: Tensor<2>,
+    /// Words of each prompt that were not in the vocabulary.
+    pub unknown: Vec<Vec<String>>,
+}
+
+impl TokenBatch {
+    /// Tokenises prompts against a vocabulary.
+    pub fn new(vocab: &Vocabulary, prompts: &[&str], device: &Device) -> Self {
+        let tokenized: Vec<(Vec<usize>, Vec<String>)> =
+            prompts.iter().map(|p| vocab.tokenize(p)).collect();
+        let len = tokenized
+            .iter()
+            .map(|(t, _)| t.len())
+            .max()
+            .unwrap_or(0)
+            .max(1);
+        let b = prompts.len();
+        let mut ids = vec![PAD as i64; b * len];
+        let mut mask = vec![0.0f32; b * len];
+        for (i, (toks, _)) in tokenized.iter().enumerate() {
+            for (k, &t) in toks.iter().enumerate() {
+                ids[i * len + k] = t as i64;
+                mask[i * len + k] = 1.0;
+            }
+        }
+        TokenBatch {
+            ids: Tensor::from_data(TensorData::new(ids, [b, len]), device),
+            mask: Tensor::from_data(TensorData::new(mask, [b, len]), device),
+            unknown: tokenized.into_iter().map(|(_, u)| u).collect(),
+        }
+    }
+}
+
+/// Anything that turns tokenised prompts into one condition vector per prompt.
+pub trait TextEncoder {
+    /// Width of the output vector.
+    fn output_dim(&self) -> usize;
+    /// `[B, output_dim]` embedding of each prompt.
+    fn encode(&self, tokens: &TokenBatch) -> Tensor<2>;
+}
+
+/// Mean of learned word embeddings (a bag of words), trained with the denoiser.
+#[derive(Module, Debug)]
+pub struct BagOfWords {
+    embedding: Embedding,
+    dim: usize,
+}
+
+impl BagOfWords {
+    /// A fresh encoder for `vocab_size` ids.
+    pub fn new(vocab_size: usize, dim: usize, device: &Device) -> Self {
+        BagOfWords {
+            embedding: EmbeddingConfig::new(vocab_size, dim).init(device),
+            dim,
+        }
+    }
+}
+
+impl TextEncoder for BagOfWords {
+    fn output_dim(&self) -> usize {
+        self.dim
+    }
+
+    fn encode(&self, tokens: &TokenBatch) -> Tensor<2> {
+        let emb = self.embedding.forward(tokens.ids.clone()); // [B, L, D]
+        let mask = tokens.mask.clone().unsqueeze_dim::<3>(2); // [B, L, 1]
+        let count = tokens.mask.clone().sum_dim(1).clamp_min(1.0); // [B, 1]
+        (emb * mask).sum_dim(1).squeeze_dim::<2>(1) / count
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_words_are_reported_not_fatal() {
+        let v = Vocabulary::from_captions(["a person walks forward", "someone runs"], 16);
+        let (ids, unknown) = v.tokenize("A person moonwalks forward!");
+        assert_eq!(ids.len(), 2);
+        assert_eq!(unknown, vec!["moonwalks".to_string()]);
+        assert!(!v.words.contains_key("a"));
+    }
+
+    #[test]
+    fn encoder_ignores_padding() {
+        let dev = Device::flex();
+        let v = Vocabulary::from_captions(["walk run jump"], 8);
+        let enc = BagOfWords::new(v.len(), 4, &dev);
+        let batch = TokenBatch::new(&v, &["walk", "walk zzz"], &dev);
+        let e = enc.encode(&batch).into_data().to_vec::<f32>().unwrap();
+        assert_eq!(e[..4], e[4..]);
+        assert_eq!(batch.unknown[1], vec!["zzz".to_string()]);
+    }
+}

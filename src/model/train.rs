@@ -1,0 +1,444 @@
+//! The training loop: masked x0-MSE on random crops, AdamW with warm-up and gradient
+//! clipping, EMA weights, periodic atomic checkpoints, resume, loss curves.
+//!
+//! ```text
+//! <out>/config.toml        the run's TrainConfig (fixed at the first start)
+//! <out>/vocab.json         the run's vocabulary (fixed at the first start)
+//! <out>/ckpt/state.json    step, wall seconds, last losses
+//! <out>/ckpt/model.bpk     training weights (burnpack, keeps parameter ids)
+//! <out>/ckpt/optim.bpk     AdamW state
+//! <out>/ckpt/ema.safetensors  EMA weights, f32
+//! <out>/bundle/            the EMA weights as a shippable model bundle (f16)
+//! <out>/loss.csv           step, train loss, learning rate, seconds
+//! <out>/val.csv            step, validation loss of the EMA weights
+//! ```
+//!
+//! A checkpoint is written whole into `ckpt.new/` and then swapped in by renames, so a
+//! kill at any moment leaves either the old or the new checkpoint complete.
+
+use super::batch::{HostBatch, draw_batch};
+use super::config::TrainConfig;
+use super::denoiser::{Denoiser, DenoiserInput, Mdm};
+use super::ema::ema_update;
+use super::noise::NoiseSource;
+use super::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use super::text::{TokenBatch, Vocabulary};
+use super::weights::{
+    BUNDLE_VERSION, Manifest, model_from_safetensors, model_to_safetensors, save_bundle_parts,
+};
+use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
+use crate::fsutil::write_bytes_atomic;
+use burn::module::Module;
+use burn::optim::{
+    AdamWConfig, GradientsParams, ModuleOptimizer, grad_clipping::GradientClippingConfig,
+};
+use burn::prelude::*;
+use burn::store::ModuleRecord;
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Progress saved with every checkpoint.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct TrainState {
+    /// Steps done.
+    pub step: usize,
+    /// Wall seconds over all sessions.
+    pub seconds: f64,
+    /// Mean training loss over the last checkpoint interval.
+    pub recent_loss: f64,
+    /// Validation loss of the EMA weights at the last checkpoint.
+    pub val_loss: Option<f64>,
+}
+
+/// Errors of a training run.
+#[derive(Debug, thiserror::Error)]
+pub enum TrainError {
+    /// Reading or writing a run file failed.
+    #[error("{path}: {reason}")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// The loss became NaN or infinite.
+    #[error(
+        "training diverged at step {step}: loss is {loss}; the last checkpoint is intact, lower the learning rate and resume"
+    )]
+    Diverged {
+        /// Step.
+        step: usize,
+        /// Value.
+        loss: f32,
+    },
+    /// The run's settings do not allow training.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+fn file_err(path: &Path, e: impl std::fmt::Display) -> TrainError {
+    TrainError::File {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    }
+}
+
+/// A batch moved to tensors.
+fn to_device(
+    batch: &HostBatch,
+    vocab: &Vocabulary,
+    device: &Device,
+) -> (DenoiserInput, Tensor<3>, Tensor<3>) {
+    let b = batch.captions.len();
+    let n = batch.frames;
+    let x0: Tensor<3> = Tensor::from_data(
+        TensorData::new(batch.x0.clone(), [b, n, FEATURE_DIM]),
+        device,
+    );
+    let valid: Vec<f32> = batch
+        .padding
+        .iter()
+        .map(|&p| if p { 0.0 } else { 1.0 })
+        .collect();
+    let valid: Tensor<3> = Tensor::from_data(TensorData::new(valid, [b, n, 1]), device);
+    let captions: Vec<&str> = batch.captions.iter().map(String::as_str).collect();
+    let input = DenoiserInput {
+        x_t: x0.clone(),
+        timesteps: batch.timesteps.clone(),
+        tokens: TokenBatch::new(vocab, &captions, device),
+        keep_text: Tensor::from_data(TensorData::new(batch.keep_text.clone(), [b]), device),
+        padding: Some(Tensor::from_data(
+            TensorData::new(batch.padding.clone(), [b, n]),
+            device,
+        )),
+    };
+    (input, x0, valid)
+}
+
+/// Noises x0 to each sample's timestep: x_t = √ᾱ x0 + √(1−ᾱ) ε.
+fn q_sample(schedule: &NoiseSchedule, x0: Tensor<3>, timesteps: &[usize], seed: u64) -> Tensor<3> {
+    let device = x0.device();
+    let dims = x0.dims();
+    let (a, s): (Vec<f32>, Vec<f32>) = timesteps
+        .iter()
+        .map(|&t| {
+            let ab = schedule.alphas_cumprod[t];
+            (ab.sqrt() as f32, (1.0 - ab).sqrt() as f32)
+        })
+        .unzip();
+    let b = timesteps.len();
+    let a: Tensor<3> = Tensor::from_data(TensorData::new(a, [b, 1, 1]), &device);
+    let s: Tensor<3> = Tensor::from_data(TensorData::new(s, [b, 1, 1]), &device);
+    let eps = NoiseSource::new(seed).tensor(dims, &device);
+    x0 * a + eps * s
+}
+
+/// Masked x0 MSE: Σ over valid frames and features / (#valid frames · F).
+pub fn masked_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+    let f = pred.dims()[2] as f32;
+    let err = (pred - x0).powi_scalar(2) * valid.clone();
+    err.sum() / (valid.sum() * f)
+}
+
+/// Loss of one batch.
+fn batch_loss(
+    model: &Mdm,
+    schedule: &NoiseSchedule,
+    batch: &HostBatch,
+    vocab: &Vocabulary,
+    device: &Device,
+) -> Tensor<1> {
+    let (mut input, x0, valid) = to_device(batch, vocab, device);
+    input.x_t = q_sample(schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
+    let pred = model.predict_x0(&input);
+    masked_mse(pred, x0, valid)
+}
+
+/// Everything a run needs besides the model.
+pub struct TrainRun<'a> {
+    /// The data.
+    pub data: &'a Dataset,
+    /// Settings.
+    pub config: TrainConfig,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Stop after this many steps in this session (None = until `config.steps`).
+    pub max_steps_now: Option<usize>,
+}
+
+struct Checkpoint {
+    model: Mdm,
+    ema: Mdm,
+    optim: ModuleOptimizer,
+    state: TrainState,
+}
+
+fn learning_rate(cfg: &TrainConfig, step: usize) -> f64 {
+    cfg.learning_rate * ((step + 1) as f64 / cfg.warmup_steps.max(1) as f64).min(1.0)
+}
+
+fn new_optimizer(cfg: &TrainConfig) -> ModuleOptimizer {
+    AdamWConfig::new()
+        .with_weight_decay(cfg.weight_decay as f32)
+        .with_grad_clipping(Some(GradientClippingConfig::Norm(cfg.grad_clip as f32)))
+        .init()
+}
+
+impl TrainRun<'_> {
+    fn ckpt(&self) -> PathBuf {
+        self.out.join("ckpt")
+    }
+
+    /// The complete checkpoint to resume from: `ckpt/`, or `ckpt.old/` when a kill hit
+    /// the swap between the two renames.
+    fn existing_checkpoint(&self) -> Option<PathBuf> {
+        ["ckpt", "ckpt.old"]
+            .iter()
+            .map(|d| self.out.join(d))
+            .find(|d| d.join("state.json").exists())
+    }
+
+    fn load_or_init(
+        &self,
+        vocab: &Vocabulary,
+        train_dev: &Device,
+        plain: &Device,
+    ) -> Result<Checkpoint, TrainError> {
+        let cfg = &self.config;
+        let Some(dir) = self.existing_checkpoint() else {
+            let model = Mdm::new(&cfg.model, vocab.len(), train_dev);
+            let ema = model.valid().to_device(plain);
+            return Ok(Checkpoint {
+                model,
+                ema,
+                optim: new_optimizer(cfg),
+                state: TrainState::default(),
+            });
+        };
+        let state_path = dir.join("state.json");
+        let state: TrainState = serde_json::from_str(
+            &std::fs::read_to_string(&state_path).map_err(|e| file_err(&state_path, e))?,
+        )
+        .map_err(|e| file_err(&state_path, e))?;
+        let model_path = dir.join("model.bpk");
+        let record =
+            ModuleRecord::load(&model_path).map_err(|e| file_err(&model_path, format!("{e:?}")))?;
+        let model = Mdm::new(&cfg.model, vocab.len(), train_dev).load_record(record);
+        let optim_path = dir.join("optim.bpk");
+        let optim = new_optimizer(cfg)
+            .load(&optim_path)
+            .map_err(|e| file_err(&optim_path, format!("{e:?}")))?;
+        let ema_path = dir.join("ema.safetensors");
+        let bytes = std::fs::read(&ema_path).map_err(|e| file_err(&ema_path, e))?;
+        let ema = model_from_safetensors(Mdm::new(&cfg.model, vocab.len(), plain), bytes, false)
+            .map_err(|e| file_err(&ema_path, e))?;
+        Ok(Checkpoint {
+            model,
+            ema,
+            optim,
+            state,
+        })
+    }
+
+    fn save(&self, ck: &Checkpoint, vocab: &Vocabulary) -> Result<(), TrainError> {
+        let dir = self.out.join("ckpt.new");
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir).map_err(|e| file_err(&dir, e))?;
+        }
+        std::fs::create_dir_all(&dir).map_err(|e| file_err(&dir, e))?;
+        let p = dir.join("model.bpk");
+        let bytes = ck
+            .model
+            .clone()
+            .into_record()
+            .into_bytes()
+            .map_err(|e| file_err(&p, format!("{e:?}")))?;
+        write_bytes_atomic(&p, &bytes).map_err(|e| file_err(&p, e))?;
+        let p = dir.join("optim.bpk");
+        let bytes = ck
+            .optim
+            .into_bytes()
+            .map_err(|e| file_err(&p, format!("{e:?}")))?;
+        write_bytes_atomic(&p, &bytes).map_err(|e| file_err(&p, e))?;
+        let p = dir.join("ema.safetensors");
+        let bytes = model_to_safetensors(&ck.ema, false).map_err(|e| file_err(&p, e))?;
+        write_bytes_atomic(&p, &bytes).map_err(|e| file_err(&p, e))?;
+        // The shippable bundle (EMA, f16).
+        let bundle = self.out.join("bundle");
+        std::fs::create_dir_all(&bundle).map_err(|e| file_err(&bundle, e))?;
+        let manifest = Manifest {
+            version: BUNDLE_VERSION,
+            weights_id: format!(
+                "mdm-{}x{}-step{}",
+                self.config.model.d_model, self.config.model.layers, ck.state.step
+            ),
+            steps: ck.state.step,
+            train_seconds: ck.state.seconds,
+            half_precision: true,
+        };
+        save_bundle_parts(
+            &bundle,
+            &self.config.model,
+            vocab,
+            &self.data.mean,
+            &self.data.std,
+            &manifest,
+        )
+        .map_err(|e| file_err(&bundle, e))?;
+        let p = bundle.join("model.safetensors");
+        let bytes = model_to_safetensors(&ck.ema, true).map_err(|e| file_err(&p, e))?;
+        write_bytes_atomic(&p, &bytes).map_err(|e| file_err(&p, e))?;
+        let p = dir.join("state.json");
+        write_bytes_atomic(
+            &p,
+            serde_json::to_string_pretty(&ck.state)
+                .expect("state")
+                .as_bytes(),
+        )
+        .map_err(|e| file_err(&p, e))?;
+        let (cur, old) = (self.ckpt(), self.out.join("ckpt.old"));
+        if old.exists() {
+            std::fs::remove_dir_all(&old).map_err(|e| file_err(&old, e))?;
+        }
+        if cur.exists() {
+            std::fs::rename(&cur, &old).map_err(|e| file_err(&cur, e))?;
+        }
+        std::fs::rename(&dir, &cur).map_err(|e| file_err(&dir, e))?;
+        if old.exists() {
+            std::fs::remove_dir_all(&old).map_err(|e| file_err(&old, e))?;
+        }
+        Ok(())
+    }
+
+    /// The run's vocabulary: read back when resuming, else built from the captions and saved.
+    fn vocabulary(&self) -> Result<Vocabulary, TrainError> {
+        let p = self.out.join("vocab.json");
+        if p.exists() {
+            let text = std::fs::read_to_string(&p).map_err(|e| file_err(&p, e))?;
+            return serde_json::from_str(&text).map_err(|e| file_err(&p, e));
+        }
+        let captions = self
+            .data
+            .index
+            .clips
+            .iter()
+            .flat_map(|c| c.captions.iter().map(String::as_str));
+        let vocab = Vocabulary::from_captions(captions, 16);
+        std::fs::create_dir_all(&self.out).map_err(|e| file_err(&self.out, e))?;
+        write_bytes_atomic(
+            &p,
+            serde_json::to_string_pretty(&vocab)
+                .expect("vocab")
+                .as_bytes(),
+        )
+        .map_err(|e| file_err(&p, e))?;
+        Ok(vocab)
+    }
+
+    /// Validation loss of the EMA weights on fixed crops of the validation split.
+    fn validate(
+        &self,
+        ema: &Mdm,
+        vocab: &Vocabulary,
+        schedule: &NoiseSchedule,
+        device: &Device,
+    ) -> Option<f64> {
+        let clips: Vec<&ClipInfo> = self.data.clips(Split::Val).collect();
+        if clips.is_empty() {
+            return None;
+        }
+        let mut cfg = self.config.clone();
+        cfg.cond_drop = 0.0;
+        let mut total = 0.0;
+        let rounds = 4;
+        for r in 0..rounds {
+            // Fixed "steps" far beyond any real step keep validation batches constant.
+            let batch = draw_batch(self.data, &clips, &cfg, usize::MAX - r);
+            let loss = batch_loss(ema, schedule, &batch, vocab, device);
+            total += loss.into_scalar::<f32>() as f64;
+        }
+        Some(total / rounds as f64)
+    }
+
+    /// Trains until `config.steps` (or `max_steps_now` more steps), resuming from the
+    /// last checkpoint in `out` if there is one.
+    pub fn run(&self, progress: &dyn Fn(&TrainState, f32, f64)) -> Result<TrainState, TrainError> {
+        let cfg = &self.config;
+        let train: Vec<&ClipInfo> = self.data.clips(Split::Train).collect();
+        if train.is_empty() {
+            return Err(TrainError::Invalid(
+                "the dataset has no training clips".into(),
+            ));
+        }
+        let vocab = self.vocabulary()?;
+        let plain = Device::flex();
+        let device = plain.clone().autodiff();
+        let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
+        let mut ck = self.load_or_init(&vocab, &device, &plain)?;
+        let stop_at = match self.max_steps_now {
+            Some(n) => (ck.state.step + n).min(cfg.steps),
+            None => cfg.steps,
+        };
+        let loss_path = self.out.join("loss.csv");
+        let mut pending = String::new();
+        let mut since_ckpt = (0.0f64, 0usize);
+        let mut clock = Instant::now();
+        while ck.state.step < stop_at {
+            let step = ck.state.step;
+            let batch = draw_batch(self.data, &train, cfg, step);
+            let loss = batch_loss(&ck.model, &schedule, &batch, &vocab, &device);
+            let value = loss.clone().into_scalar::<f32>();
+            if !value.is_finite() {
+                return Err(TrainError::Diverged { step, loss: value });
+            }
+            let grads = GradientsParams::from_grads(loss.backward(), &ck.model);
+            let lr = learning_rate(cfg, step);
+            ck.model = ck.optim.step(lr, ck.model, grads);
+            let decay = (cfg.ema_decay as f32).min((1 + step) as f32 / (10 + step) as f32);
+            ck.ema = ema_update(ck.ema, &ck.model.valid(), decay);
+            ck.state.step += 1;
+            let now = Instant::now();
+            ck.state.seconds += (now - clock).as_secs_f64();
+            clock = now;
+            since_ckpt = (since_ckpt.0 + value as f64, since_ckpt.1 + 1);
+            pending.push_str(&format!(
+                "{},{value},{lr},{:.1}\n",
+                ck.state.step, ck.state.seconds
+            ));
+            progress(&ck.state, value, lr);
+            if ck.state.step % cfg.checkpoint_every == 0 || ck.state.step == stop_at {
+                ck.state.recent_loss = since_ckpt.0 / since_ckpt.1.max(1) as f64;
+                since_ckpt = (0.0, 0);
+                ck.state.val_loss = self.validate(&ck.ema, &vocab, &schedule, &plain);
+                append(&loss_path, "step,loss,lr,seconds\n", &pending)?;
+                pending.clear();
+                if let Some(v) = ck.state.val_loss {
+                    append(
+                        &self.out.join("val.csv"),
+                        "step,val_loss,seconds\n",
+                        &format!("{},{v},{:.1}\n", ck.state.step, ck.state.seconds),
+                    )?;
+                }
+                self.save(&ck, &vocab)?;
+                clock = Instant::now();
+            }
+        }
+        Ok(ck.state)
+    }
+}
+
+fn append(path: &Path, header: &str, rows: &str) -> Result<(), TrainError> {
+    let new = !path.exists();
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .map_err(|e| file_err(path, e))?;
+    if new {
+        f.write_all(header.as_bytes())
+            .map_err(|e| file_err(path, e))?;
+    }
+    f.write_all(rows.as_bytes()).map_err(|e| file_err(path, e))
+}

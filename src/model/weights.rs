@@ -1,0 +1,271 @@
+//! A model bundle on disk: weights (SafeTensors, f16 for shipping, f32 for checkpoints),
+//! config, vocabulary and normalisation statistics, with version and shape checks.
+//!
+//! ```text
+//! <dir>/manifest.json      format version, weights id, training summary
+//! <dir>/config.toml        ModelConfig
+//! <dir>/vocab.json         Vocabulary
+//! <dir>/mean.npy, std.npy  [263] normalisation statistics
+//! <dir>/model.safetensors  denoiser weights
+//! ```
+
+use super::config::ModelConfig;
+use super::denoiser::Mdm;
+use super::text::Vocabulary;
+use crate::dataset::store::{read_f32_npy, write_f32_npy};
+use crate::fsutil::write_bytes_atomic;
+use burn::prelude::*;
+use burn::store::{HalfPrecisionAdapter, ModuleSnapshot, SafetensorsStore};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Version of the bundle layout.
+pub const BUNDLE_VERSION: u32 = 1;
+
+/// Summary stored with the weights.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// [`BUNDLE_VERSION`].
+    pub version: u32,
+    /// Short id of these weights (saved next to every output for reproducibility).
+    pub weights_id: String,
+    /// Optimisation steps the weights saw.
+    pub steps: usize,
+    /// Wall seconds of training.
+    pub train_seconds: f64,
+    /// Whether the SafeTensors file holds f16 values.
+    pub half_precision: bool,
+}
+
+/// Errors while loading or saving a bundle.
+#[derive(Debug, thiserror::Error)]
+pub enum WeightsError {
+    /// Missing or unreadable file.
+    #[error("cannot read {path}: {reason}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// The bundle does not fit this build.
+    #[error("{path}: {reason}")]
+    Mismatch {
+        /// The file.
+        path: PathBuf,
+        /// What does not fit.
+        reason: String,
+    },
+    /// Writing failed.
+    #[error("cannot write {path}: {reason}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// A loaded model with everything needed to sample.
+#[derive(Debug)]
+pub struct ModelBundle {
+    /// Denoiser shape.
+    pub config: ModelConfig,
+    /// Text vocabulary.
+    pub vocab: Vocabulary,
+    /// `[263]` feature mean.
+    pub mean: Vec<f32>,
+    /// `[263]` feature std.
+    pub std: Vec<f32>,
+    /// The denoiser.
+    pub model: Mdm,
+    /// Manifest.
+    pub manifest: Manifest,
+}
+
+fn read_text(path: &Path) -> Result<String, WeightsError> {
+    std::fs::read_to_string(path).map_err(|e| WeightsError::Read {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })
+}
+
+fn mismatch(path: &Path, reason: impl Into<String>) -> WeightsError {
+    WeightsError::Mismatch {
+        path: path.to_path_buf(),
+        reason: reason.into(),
+    }
+}
+
+fn write_err(path: &Path, e: impl std::fmt::Display) -> WeightsError {
+    WeightsError::Write {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    }
+}
+
+/// Serialises a denoiser to SafeTensors bytes.
+pub fn model_to_safetensors(model: &Mdm, half: bool) -> Result<Vec<u8>, String> {
+    let mut store = SafetensorsStore::from_bytes(None);
+    if half {
+        store = store.with_to_adapter(HalfPrecisionAdapter::new());
+    }
+    model.save_into(&mut store).map_err(|e| e.to_string())?;
+    store.get_bytes().map_err(|e| e.to_string())
+}
+
+/// Loads SafeTensors bytes into a freshly built denoiser; every tensor must be present
+/// with the right shape.
+pub fn model_from_safetensors(mut model: Mdm, bytes: Vec<u8>, half: bool) -> Result<Mdm, String> {
+    let mut store = SafetensorsStore::from_bytes(Some(bytes));
+    if half {
+        store = store.with_from_adapter(HalfPrecisionAdapter::new());
+    }
+    let result = model.load_from(&mut store).map_err(|e| {
+        let text = e.to_string();
+        let short: String = text.chars().take(400).collect();
+        let more = if text.len() > short.len() { " …" } else { "" };
+        format!("weights do not fit the configured model: {short}{more}")
+    })?;
+    if !result.errors.is_empty() || !result.missing.is_empty() {
+        return Err(format!(
+            "weights do not fit the configured model: {} errors ({}), {} missing tensors ({})",
+            result.errors.len(),
+            result
+                .errors
+                .iter()
+                .take(3)
+                .map(|e| format!("{e:?}"))
+                .collect::<Vec<_>>()
+                .join("; "),
+            result.missing.len(),
+            result
+                .missing
+                .iter()
+                .take(3)
+                .map(|m| format!("{m:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    Ok(model)
+}
+
+impl ModelBundle {
+    /// Loads a bundle from `dir` onto `device`.
+    pub fn load(dir: &Path, device: &Device) -> Result<ModelBundle, WeightsError> {
+        let manifest_path = dir.join("manifest.json");
+        let manifest: Manifest = serde_json::from_str(&read_text(&manifest_path)?)
+            .map_err(|e| mismatch(&manifest_path, format!("bad manifest: {e}")))?;
+        if manifest.version != BUNDLE_VERSION {
+            return Err(mismatch(
+                &manifest_path,
+                format!(
+                    "model bundle version {} but this mprog reads version {BUNDLE_VERSION}",
+                    manifest.version
+                ),
+            ));
+        }
+        let config_path = dir.join("config.toml");
+        let config: ModelConfig = toml::from_str(&read_text(&config_path)?)
+            .map_err(|e| mismatch(&config_path, format!("bad model config: {e}")))?;
+        let vocab_path = dir.join("vocab.json");
+        let vocab: Vocabulary = serde_json::from_str(&read_text(&vocab_path)?)
+            .map_err(|e| mismatch(&vocab_path, format!("bad vocabulary: {e}")))?;
+        let stat = |name: &str| -> Result<Vec<f32>, WeightsError> {
+            let p = dir.join(name);
+            let (_, v) = read_f32_npy(&p, &[]).map_err(|e| mismatch(&p, e.to_string()))?;
+            if v.len() != config.features {
+                return Err(mismatch(
+                    &p,
+                    format!(
+                        "{} values, the model has {} features",
+                        v.len(),
+                        config.features
+                    ),
+                ));
+            }
+            Ok(v)
+        };
+        let mean = stat("mean.npy")?;
+        let std = stat("std.npy")?;
+        let weights_path = dir.join("model.safetensors");
+        let bytes = std::fs::read(&weights_path).map_err(|e| WeightsError::Read {
+            path: weights_path.clone(),
+            reason: e.to_string(),
+        })?;
+        let fresh = Mdm::new(&config, vocab.len(), device);
+        let model = model_from_safetensors(fresh, bytes, manifest.half_precision)
+            .map_err(|reason| mismatch(&weights_path, reason))?;
+        Ok(ModelBundle {
+            config,
+            vocab,
+            mean,
+            std,
+            model,
+            manifest,
+        })
+    }
+
+    /// Writes the bundle to `dir` (each file atomically).
+    pub fn save(&self, dir: &Path) -> Result<(), WeightsError> {
+        std::fs::create_dir_all(dir).map_err(|e| write_err(dir, e))?;
+        save_bundle_parts(
+            dir,
+            &self.config,
+            &self.vocab,
+            &self.mean,
+            &self.std,
+            &self.manifest,
+        )?;
+        let p = dir.join("model.safetensors");
+        let bytes = model_to_safetensors(&self.model, self.manifest.half_precision)
+            .map_err(|e| write_err(&p, e))?;
+        write_bytes_atomic(&p, &bytes).map_err(|e| write_err(&p, e))
+    }
+}
+
+/// Writes everything of a bundle except the weights.
+pub fn save_bundle_parts(
+    dir: &Path,
+    config: &ModelConfig,
+    vocab: &Vocabulary,
+    mean: &[f32],
+    std: &[f32],
+    manifest: &Manifest,
+) -> Result<(), WeightsError> {
+    let put = |name: &str, text: String| {
+        let p = dir.join(name);
+        write_bytes_atomic(&p, text.as_bytes()).map_err(|e| write_err(&p, e))
+    };
+    put(
+        "manifest.json",
+        serde_json::to_string_pretty(manifest).expect("manifest serialises"),
+    )?;
+    put(
+        "config.toml",
+        toml::to_string(config).expect("config serialises"),
+    )?;
+    put(
+        "vocab.json",
+        serde_json::to_string_pretty(vocab).expect("vocab serialises"),
+    )?;
+    for (name, v) in [("mean.npy", mean), ("std.npy", std)] {
+        let p = dir.join(name);
+        write_f32_npy(&p, &[v.len() as u64], v).map_err(|e| write_err(&p, e))?;
+    }
+    Ok(())
+}
+
+/// Where the shipped model lives: `$MPROG_MODEL`, else `models/default` under the current
+/// directory, else the one in the source tree this binary was built from.
+pub fn default_model_dir() -> PathBuf {
+    if let Ok(p) = std::env::var("MPROG_MODEL") {
+        return PathBuf::from(p);
+    }
+    let local = PathBuf::from("models/default");
+    if local.join("manifest.json").exists() {
+        return local;
+    }
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/default")
+}
