@@ -16,6 +16,9 @@ struct Cli {
 enum Command {
     /// Print the joint names and aliases of the skeleton.
     Joints,
+    /// Build a training set from BVH files.
+    #[command(subcommand)]
+    Data(cli::data::DataCommand),
     /// Train the denoiser on a dataset built by `mprog data build`.
     Train(cli::train::TrainArgs),
 }
@@ -24,6 +27,7 @@ fn main() -> miette::Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Joints => print_joints(),
+        Command::Data(cmd) => cli::data::run(cmd)?,
         Command::Train(args) => cli::train::run(args)?,
     }
     Ok(())

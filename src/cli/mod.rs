@@ -1,3 +1,4 @@
 //! Subcommands of the `mprog` binary, one file each.
 
 pub mod train;
+pub mod data;

@@ -7,6 +7,7 @@ pub mod batch;
 pub mod config;
 pub mod denoiser;
 pub mod ema;
+pub mod generate;
 pub mod noise;
 pub mod sampler;
 pub mod schedule;
