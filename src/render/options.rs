@@ -1,0 +1,105 @@
+//! What a caller can ask of a motion render: caption, picture sizes, which frames, the
+//! camera, and overlay geometry (points, segments, planes, boxes in world coordinates)
+//! drawn into both views. Plain data in, validated by the renderers.
+
+use glam::Vec3;
+use std::ops::Range;
+
+/// Options shared by [`render_gif`](super::render_gif) and
+/// [`render_strip_png`](super::render_strip_png).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Caption drawn at the top (e.g. the prompt); empty for none.
+    pub title: String,
+    /// GIF frame size in pixels (width, height): side view on the left, top view on the right.
+    pub size: (u32, u32),
+    /// Width of the strip PNG in pixels; its height follows from the layout.
+    pub strip_width: u32,
+    /// GIF: draw every `frame_step`-th frame (1 = every frame). The GIF still plays at the
+    /// motion's real speed: each GIF frame lasts `frame_step / fps` seconds.
+    pub frame_step: usize,
+    /// Restrict both outputs to these frames (`None`: the whole clip).
+    pub frame_range: Option<Range<usize>>,
+    /// Which frames the strip shows.
+    pub strip_frames: StripFrames,
+    /// Side-view camera heading in degrees about +Y (0: the view that shows a walk along
+    /// +Z from the walker's right-front, moving rightwards). `None`: follow the clip's net
+    /// travel direction (or the first frame's facing when it barely travels).
+    pub camera_yaw_deg: Option<f32>,
+    /// Extra geometry drawn into both views.
+    pub overlays: Vec<Overlay>,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            title: String::new(),
+            size: (640, 320),
+            strip_width: 1280,
+            // 10 fps keeps a 10 s clip around a megabyte and still reads as smooth motion.
+            frame_step: 2,
+            frame_range: None,
+            strip_frames: StripFrames::Count(8),
+            camera_yaw_deg: None,
+            overlays: Vec::new(),
+        }
+    }
+}
+
+impl RenderOptions {
+    /// Default options with a caption.
+    pub fn titled(title: impl Into<String>) -> Self {
+        RenderOptions { title: title.into(), ..Self::default() }
+    }
+}
+
+/// Frames shown by the strip PNG.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StripFrames {
+    /// This many evenly spaced frames, first and last included (fewer if the clip is shorter).
+    Count(usize),
+    /// Exactly these frame indices, in this order.
+    Indices(Vec<usize>),
+}
+
+/// A piece of geometry to draw into the scene (metres, world coordinates, Y up).
+///
+/// Planes are unbounded, so they are drawn as outlines clipped to the floor area of the
+/// scene (the clip's horizontal extent plus a margin) and its height range.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Overlay {
+    /// A marked point, e.g. a target, with an optional text label.
+    Point {
+        /// Position.
+        at: Vec3,
+        /// Label drawn beside the point.
+        label: Option<String>,
+    },
+    /// A straight line segment.
+    Segment {
+        /// Start.
+        from: Vec3,
+        /// End.
+        to: Vec3,
+    },
+    /// A vertical plane (a wall) through `point` with horizontal normal `normal`
+    /// (its Y component is ignored).
+    VerticalPlane {
+        /// Any point on the plane; it is kept inside the camera's view.
+        point: Vec3,
+        /// Plane normal; must have a non-zero horizontal part.
+        normal: Vec3,
+    },
+    /// A horizontal plane `y = height` (a floor, a ceiling, a height limit).
+    HorizontalPlane {
+        /// Height in metres.
+        height: f32,
+    },
+    /// An axis-aligned box between two corners.
+    Box {
+        /// Lowest corner.
+        min: Vec3,
+        /// Highest corner.
+        max: Vec3,
+    },
+}

@@ -1,0 +1,226 @@
+//! Line plots to PNG: named series of (x, y) points drawn with axes, ticks, axis labels, a
+//! title and a legend, on a linear or logarithmic y axis — training loss curves and a
+//! program's per-statement error over time.
+
+use super::draw::render_rgb;
+use super::encode::encode_png;
+use super::error::{RenderError, draw_err};
+use super::font::{FAMILY, ensure_fonts};
+use crate::fsutil::write_bytes_atomic;
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::prelude::*;
+use std::ops::Range;
+use std::path::Path;
+
+/// One named line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// Points in drawing order.
+    pub points: Vec<(f32, f32)>,
+}
+
+/// Plot appearance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlotOptions {
+    /// Picture size in pixels (width, height).
+    pub size: (u32, u32),
+    /// Logarithmic y axis (points with y ≤ 0 are left out).
+    pub log_y: bool,
+}
+
+impl Default for PlotOptions {
+    fn default() -> Self {
+        PlotOptions { size: (800, 480), log_y: false }
+    }
+}
+
+/// Series colours (Tableau 10), cycled.
+const COLORS: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// Series with at most this many points also get a dot at each point.
+const MARK_POINTS_UP_TO: usize = 40;
+
+/// Draws `series` as a PNG line plot at `path` (which must end in `.png`).
+///
+/// Non-finite points (a diverged loss) and, with `log_y`, points with y ≤ 0 are left out
+/// of the drawing; it is an error when no point remains. Nothing is written on error.
+pub fn plot_lines(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    opts: &PlotOptions,
+) -> Result<(), RenderError> {
+    let is_png = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        return Err(RenderError::UnknownFormat(path.to_path_buf()));
+    }
+    let bytes = plot_png(title, x_label, y_label, series, opts)?;
+    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io { path: path.to_path_buf(), source })
+}
+
+/// The plot's PNG bytes.
+pub(crate) fn plot_png(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    opts: &PlotOptions,
+) -> Result<Vec<u8>, RenderError> {
+    let (w, h) = opts.size;
+    if w < 200 || h < 150 {
+        return Err(RenderError::BadOption(format!("plot size {w}x{h} is too small (min 200x150)")));
+    }
+    let kept: Vec<Vec<(f32, f32)>> = series
+        .iter()
+        .map(|s| {
+            let keep = |&&(x, y): &&(f32, f32)| x.is_finite() && y.is_finite() && (!opts.log_y || y > 0.0);
+            s.points.iter().filter(keep).copied().collect()
+        })
+        .collect();
+    let all: Vec<(f32, f32)> = kept.iter().flatten().copied().collect();
+    if all.is_empty() {
+        let why = if opts.log_y { "no finite positive points for a log-scale plot" } else { "no finite points" };
+        return Err(RenderError::BadPlot(why.into()));
+    }
+    let xr = padded(all.iter().map(|p| p.0), false);
+    let yr = padded(all.iter().map(|p| p.1), opts.log_y);
+    ensure_fonts()?;
+    let labels = Labels { title, x: x_label, y: y_label };
+    let rgb = render_rgb(w, h, |area| {
+        area.fill(&WHITE).map_err(draw_err)?;
+        if opts.log_y {
+            chart(area, &labels, xr, yr.log_scale(), series, &kept)
+        } else {
+            chart(area, &labels, xr, yr, series, &kept)
+        }
+    })?;
+    encode_png(&rgb, w, h)
+}
+
+struct Labels<'a> {
+    title: &'a str,
+    x: &'a str,
+    y: &'a str,
+}
+
+/// Data range with a 5 % margin (multiplicative on a log axis); a single value gets a
+/// unit-wide (or factor-of-two) range around it.
+fn padded(values: impl Iterator<Item = f32>, log: bool) -> Range<f32> {
+    let (lo, hi) = values.fold((f32::MAX, f32::MIN), |(a, b), v| (a.min(v), b.max(v)));
+    if log {
+        if hi <= lo * 1.0001 {
+            return lo / 2.0..hi * 2.0;
+        }
+        let f = (hi / lo).powf(0.05);
+        return lo / f..hi * f;
+    }
+    if hi - lo <= f32::EPSILON * hi.abs().max(1.0) {
+        return lo - 0.5..hi + 0.5;
+    }
+    let m = (hi - lo) * 0.05;
+    lo - m..hi + m
+}
+
+/// Tick text: plain for ordinary magnitudes, scientific for tiny or huge ones.
+fn tick(v: f32) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e5).contains(&a) {
+        format!("{v:.1e}")
+    } else {
+        let s = format!("{v:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+fn chart<'a, Y>(
+    area: &DrawingArea<BitMapBackend<'a>, Shift>,
+    labels: &Labels,
+    xr: Range<f32>,
+    yr: Y,
+    series: &[Series],
+    kept: &[Vec<(f32, f32)>],
+) -> Result<(), RenderError>
+where
+    Y: AsRangedCoord<Value = f32>,
+    Y::CoordDescType: ValueFormatter<f32>,
+{
+    let mut chart = ChartBuilder::on(area)
+        .caption(labels.title, (FAMILY, 18))
+        .margin(12)
+        .x_label_area_size(42)
+        .y_label_area_size(64)
+        .build_cartesian_2d(xr, yr)
+        .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc(labels.x)
+        .y_desc(labels.y)
+        .x_labels(8)
+        .y_labels(8)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .label_style((FAMILY, 12))
+        .axis_desc_style((FAMILY, 14))
+        .light_line_style(RGBColor(238, 238, 238))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .draw()
+        .map_err(draw_err)?;
+    for (i, (s, pts)) in series.iter().zip(kept).enumerate() {
+        let color = COLORS[i % COLORS.len()];
+        let style = color.stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), style))
+            .map_err(draw_err)?
+            .label(s.name.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        if pts.len() <= MARK_POINTS_UP_TO {
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                .map_err(draw_err)?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(170, 170, 170))
+        .label_font((FAMILY, 13))
+        .draw()
+        .map_err(draw_err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_and_ticks() {
+        assert_eq!(padded([2.0, 2.0].into_iter(), false), 1.5..2.5);
+        let r = padded([0.0, 10.0].into_iter(), false);
+        assert!((r.start + 0.5).abs() < 1e-6 && (r.end - 10.5).abs() < 1e-6);
+        let l = padded([1e-3, 10.0].into_iter(), true);
+        assert!(l.start < 1e-3 && l.start > 0.0 && l.end > 10.0);
+        assert_eq!(tick(0.25), "0.25");
+        assert_eq!(tick(3.0), "3");
+        assert_eq!(tick(0.0), "0");
+        assert_eq!(tick(1.5e-5), "1.5e-5");
+    }
+}

@@ -1,0 +1,172 @@
+//! A validated scene: the people (motions) and overlays to draw, checked once (non-empty,
+//! finite, one frame rate), with what every view needs derived from the whole clip — the
+//! bounds the fixed cameras fit, the floor area, the heading of the side camera, and each
+//! frame's pose and facing direction.
+
+use super::error::RenderError;
+use super::options::{Overlay, RenderOptions};
+use super::overlay_geom::{Prim, overlay_prims};
+use crate::motion::{Motion, Pose};
+use crate::skeleton::FACE_JOINTS;
+use glam::{Vec2, Vec3};
+
+/// Space left around the clip's horizontal extent on the floor (metres).
+const FLOOR_MARGIN: f32 = 0.5;
+/// Net root travel (metres) above which the side camera follows the travel direction.
+const TRAVEL_FOR_HEADING: f32 = 0.5;
+
+/// People and overlays ready to draw.
+pub(crate) struct Scene<'a> {
+    people: &'a [Motion],
+    /// Frames per second shared by all people.
+    pub fps: f32,
+    /// Frames in the scene (the longest person; shorter ones hold their last pose).
+    pub len: usize,
+    /// Lower corner of everything that must stay in view (floor included).
+    pub lo: Vec3,
+    /// Upper corner of everything that must stay in view.
+    pub hi: Vec3,
+    /// Floor rectangle as (x, z) corners.
+    pub floor_lo: Vec2,
+    /// See `floor_lo`.
+    pub floor_hi: Vec2,
+    /// Overlays as lines and dots.
+    pub prims: Vec<Prim>,
+    /// Side camera heading about +Y (radians); 0 looks at a +Z walk from its right-front.
+    pub yaw: f32,
+}
+
+impl<'a> Scene<'a> {
+    /// Checks the people and overlays and derives the fixed framing.
+    pub fn new(people: &'a [Motion], opts: &RenderOptions) -> Result<Self, RenderError> {
+        let fps = validate_people(people)?;
+        let len = people.iter().map(Motion::len).max().unwrap_or(0);
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for m in people {
+            let (a, b) = m.bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+        for (index, o) in opts.overlays.iter().enumerate() {
+            for p in anchor_points(o, index)? {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            // A horizontal plane spans the floor area; only its height must be in view.
+            if let Overlay::HorizontalPlane { height } = o {
+                lo.y = lo.y.min(*height);
+                hi.y = hi.y.max(*height);
+            }
+        }
+        // The floor is always in view, and a person is at least standing height tall.
+        lo.y = lo.y.min(0.0);
+        hi.y = hi.y.max(lo.y + 1.0);
+        let floor_lo = Vec2::new(lo.x, lo.z) - FLOOR_MARGIN;
+        let floor_hi = Vec2::new(hi.x, hi.z) + FLOOR_MARGIN;
+        lo = lo.min(Vec3::new(floor_lo.x, lo.y, floor_lo.y));
+        hi = hi.max(Vec3::new(floor_hi.x, hi.y, floor_hi.y));
+        let prims = overlay_prims(&opts.overlays, floor_lo, floor_hi, lo.y, hi.y);
+        let mut scene = Scene { people, fps, len, lo, hi, floor_lo, floor_hi, prims, yaw: 0.0 };
+        scene.yaw = match opts.camera_yaw_deg {
+            Some(d) if d.is_finite() => d.to_radians(),
+            Some(d) => return Err(RenderError::BadOption(format!("camera yaw {d} is not finite"))),
+            None => scene.auto_yaw(),
+        };
+        Ok(scene)
+    }
+
+    /// Number of people.
+    pub fn people(&self) -> usize {
+        self.people.len()
+    }
+
+    /// Pose of `person` at `frame`; a clip shorter than the scene holds its last pose.
+    pub fn pose(&self, person: usize, frame: usize) -> &Pose {
+        let frames = &self.people[person].frames;
+        &frames[frame.min(frames.len() - 1)]
+    }
+
+    /// Root (pelvis) positions of `person` over the whole clip.
+    pub fn root_trail(&self, person: usize) -> Vec<Vec3> {
+        self.people[person].joint_track(0)
+    }
+
+    /// Seconds at `frame`.
+    pub fn time(&self, frame: usize) -> f32 {
+        frame as f32 / self.fps
+    }
+
+    /// Heading that shows person 0 travelling rightwards, or facing the camera's side.
+    fn auto_yaw(&self) -> f32 {
+        let first = self.pose(0, 0)[0];
+        let last = self.pose(0, self.len - 1)[0];
+        let travel = Vec2::new(last.x - first.x, last.z - first.z);
+        let dir = if travel.length() > TRAVEL_FOR_HEADING {
+            travel
+        } else {
+            facing(self.pose(0, 0)).map_or(Vec2::Y, |f| Vec2::new(f.x, f.z))
+        };
+        dir.x.atan2(dir.y)
+    }
+}
+
+/// Horizontal unit facing direction of a pose by HumanML3D's rule, up × across with
+/// across = (right hip − left hip) + (right shoulder − left shoulder); `None` when the hips
+/// and shoulders give no horizontal direction.
+pub(crate) fn facing(pose: &Pose) -> Option<Vec3> {
+    let [r_hip, l_hip, r_sh, l_sh] = FACE_JOINTS;
+    let across = (pose[r_hip] - pose[l_hip]) + (pose[r_sh] - pose[l_sh]);
+    let f = Vec3::Y.cross(across);
+    let f = Vec3::new(f.x, 0.0, f.z);
+    (f.length() > 1e-6).then(|| f.normalize())
+}
+
+/// Checks every motion; returns the shared frame rate.
+fn validate_people(people: &[Motion]) -> Result<f32, RenderError> {
+    let first = people.first().ok_or(RenderError::NoPeople)?;
+    for (person, m) in people.iter().enumerate() {
+        if m.is_empty() {
+            return Err(RenderError::EmptyMotion { person });
+        }
+        if !(m.fps.is_finite() && m.fps > 0.0) {
+            return Err(RenderError::BadFps { person, fps: m.fps });
+        }
+        if (m.fps - first.fps).abs() > 1e-4 {
+            return Err(RenderError::FpsMismatch { person, fps: m.fps, first: first.fps });
+        }
+        for (frame, pose) in m.frames.iter().enumerate() {
+            if let Some(joint) = pose.iter().position(|p| !p.is_finite()) {
+                return Err(RenderError::NonFinite { person, frame, joint });
+            }
+        }
+    }
+    Ok(first.fps)
+}
+
+/// Points of an overlay that must be in view; rejects non-finite or degenerate overlays.
+fn anchor_points(o: &Overlay, index: usize) -> Result<Vec<Vec3>, RenderError> {
+    let bad = |reason: &str| RenderError::BadOverlay { index, reason: reason.to_string() };
+    let points = match o {
+        Overlay::Point { at, .. } => vec![*at],
+        Overlay::Segment { from, to } => vec![*from, *to],
+        Overlay::VerticalPlane { point, normal } => {
+            if !normal.is_finite() || Vec2::new(normal.x, normal.z).length() < 1e-6 {
+                return Err(bad("a vertical plane needs a finite normal with a horizontal part"));
+            }
+            vec![*point]
+        }
+        Overlay::HorizontalPlane { height } if height.is_finite() => vec![],
+        Overlay::HorizontalPlane { .. } => return Err(bad("plane height is not finite")),
+        Overlay::Box { min, max } => {
+            if min.is_finite() && max.is_finite() && min.cmpgt(*max).any() {
+                return Err(bad("box min corner is above its max corner"));
+            }
+            vec![*min, *max]
+        }
+    };
+    if points.iter().all(|p| p.is_finite()) {
+        Ok(points)
+    } else {
+        Err(bad("coordinates are not finite"))
+    }
+}
