@@ -19,6 +19,9 @@ enum Command {
     /// Build a training set from BVH files.
     #[command(subcommand)]
     Data(cli::data::DataCommand),
+    /// Timing benchmarks printed as markdown tables.
+    #[command(subcommand)]
+    Bench(cli::bench::BenchCommand),
     /// Train the denoiser on a dataset built by `mprog data build`.
     Train(cli::train::TrainArgs),
 }
@@ -29,6 +32,7 @@ fn main() -> miette::Result<()> {
         Command::Joints => print_joints(),
         Command::Data(cmd) => cli::data::run(cmd)?,
         Command::Train(args) => cli::train::run(args)?,
+        Command::Bench(cmd) => cli::bench::run(cmd)?,
     }
     Ok(())
 }

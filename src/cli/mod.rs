@@ -2,3 +2,4 @@
 
 pub mod train;
 pub mod data;
+pub mod bench;

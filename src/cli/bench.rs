@@ -1,0 +1,121 @@
+//! `mprog bench`: timing tables (medians over repeated runs) printed as markdown.
+
+use miette::Result;
+use mprog::model::denoiser::{Denoiser, DenoiserInput, Mdm};
+use mprog::model::noise::NoiseSource;
+use mprog::model::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
+use mprog::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use mprog::model::text::{TokenBatch, Vocabulary};
+use mprog::model::{ModelBundle, ModelConfig};
+use burn::prelude::*;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// `mprog bench …`
+#[derive(clap::Subcommand)]
+pub enum BenchCommand {
+    /// Denoiser forward / forward+backward and DDIM sampling times.
+    Model(ModelBenchArgs),
+}
+
+/// Arguments of `mprog bench model`.
+#[derive(clap::Args)]
+pub struct ModelBenchArgs {
+    /// Model bundle (its config sets the shape; default: the shipped model, else the
+    /// default config with random weights).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Repetitions per cell (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    reps: usize,
+    /// Frames per motion.
+    #[arg(long, default_value_t = 120)]
+    frames: usize,
+}
+
+/// Runs `mprog bench …`.
+pub fn run(cmd: BenchCommand) -> Result<()> {
+    match cmd {
+        BenchCommand::Model(args) => bench_model(args),
+    }
+}
+
+fn median_ms(reps: usize, mut f: impl FnMut()) -> f64 {
+    f(); // warm-up
+    let mut times: Vec<f64> = (0..reps)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+fn bench_model(args: ModelBenchArgs) -> Result<()> {
+    let plain = Device::flex();
+    let dir = args.model.clone().unwrap_or_else(mprog::model::weights::default_model_dir);
+    let (config, vocab, model) = match ModelBundle::load(&dir, &plain) {
+        Ok(b) => (b.config, b.vocab, b.model),
+        Err(e) => {
+            eprintln!("({e}; timing the default config with random weights)");
+            let config = ModelConfig::default();
+            let vocab = Vocabulary::from_captions(["a person walks forward"], 16);
+            let model = Mdm::new(&config, vocab.len(), &plain);
+            (config, vocab, model)
+        }
+    };
+    let n = args.frames;
+    println!(
+        "denoiser d_model {} × {} layers, {} params, {n} frames, flex backend, median of {} runs\n",
+        config.d_model,
+        config.layers,
+        model.num_params(),
+        args.reps
+    );
+    println!("| measurement | batch 1 | batch 32 |\n| --- | --- | --- |");
+    let input = |b: usize, dev: &Device| DenoiserInput {
+        x_t: NoiseSource::new(1).tensor([b, n, config.features], dev),
+        timesteps: vec![500; b],
+        tokens: TokenBatch::new(&vocab, &vec!["a person walks forward"; b], dev),
+        keep_text: Tensor::ones([b], dev),
+        padding: None,
+    };
+    let inference = model.valid();
+    let fwd: Vec<f64> = [1, 32]
+        .iter()
+        .map(|&b| {
+            let inp = input(b, &plain);
+            median_ms(args.reps, || {
+                let _ = inference.predict_x0(&inp).into_data();
+            })
+        })
+        .collect();
+    println!("| forward (inference) | {:.1} ms | {:.1} ms |", fwd[0], fwd[1]);
+    let ad = plain.clone().autodiff();
+    let train = model.clone().to_device(&ad);
+    let fb: Vec<f64> = [1, 32]
+        .iter()
+        .map(|&b| {
+            let inp = input(b, &ad);
+            median_ms(args.reps, || {
+                let loss = train.predict_x0(&inp).powi_scalar(2).mean();
+                let _ = loss.backward();
+            })
+        })
+        .collect();
+    println!("| forward + backward (training) | {:.1} ms | {:.1} ms |", fb[0], fb[1]);
+    let base = NoiseSchedule::cosine(DIFFUSION_STEPS);
+    let cond = Condition::new(&vocab, &["a person walks forward"], 2.5, &plain);
+    for steps in [50, 100] {
+        let kind = SamplerKind::Ddim(steps);
+        let s = schedule_for(&base, kind);
+        let ms = median_ms(1.max(args.reps / 2), || {
+            let x = NoiseSource::new(1).tensor([1, n, config.features], &plain);
+            let _ = sample_chain(&inference, &s, kind, x, &cond, &mut NoiseSource::new(2), |_, _| {}).into_data();
+        });
+        println!("| DDIM {steps} steps, CFG 2.5 (1 motion) | {:.2} s | |", ms / 1e3);
+    }
+    Ok(())
+}
