@@ -1,1 +1,3 @@
-//! Motion file formats: BVH import/export, `.npy` joint arrays, `.json`.
+//! Motion file formats: BVH import, `.npy` joint arrays, `.json`.
+
+pub mod bvh;
