@@ -1,242 +1,9 @@
-//! Tests of the whole BVH import on small hand-written inputs: FK against hand-computed
-//! positions for several channel orders, text variants (CRLF, tabs, exponents), every
-//! error case with its line number, and joint mapping of several rigs.
+//! Joint mapping of CMU, Mixamo, SMPL-style and Bandai-named rigs; fill-ins, unmappable
+//! rigs, unit detection and overrides.
 
-use super::*;
+use super::super::*;
+use super::assert_close;
 use glam::Vec3;
-
-fn parse(text: &str) -> Result<Bvh, BvhError> {
-    parse_bvh("t.bvh", text, ParseLimits::default())
-}
-
-/// Root (6 channels) → `Mid` (`mid_channels`, offset 0 10 0) → End Site (0 0 10).
-fn chain(mid_channels: &str, frame: &str) -> String {
-    format!(
-        "HIERARCHY\nROOT Root\n{{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n  JOINT Mid\n  {{\n    OFFSET 0 10 0\n    CHANNELS {mid_channels}\n    End Site\n    {{\n      OFFSET 0 0 10\n    }}\n  }}\n}}\nMOTION\nFrames: 1\nFrame Time: 0.05\n{frame}\n"
-    )
-}
-
-fn positions(text: &str) -> Vec<Vec3> {
-    fk::global_positions(&parse(text).unwrap())
-}
-
-fn assert_close(a: Vec3, b: Vec3) {
-    assert!((a - b).length() < 1e-4, "{a} != {b}");
-}
-
-#[test]
-fn fk_rotation_orders_compose_intrinsically() {
-    // Root at (1,2,3) turned 90° about Z: Mid's offset (0,10,0) goes to (-10,0,0).
-    // Mid ZXY = (90, 90, 90) on (0,0,10): Ry → (10,0,0), Rx keeps it, Rz → (0,10,0);
-    // then the root's Rz turns it to (-10,0,0).
-    let p = positions(&chain(
-        "3 Zrotation Xrotation Yrotation",
-        "1 2 3 90 0 0 90 90 90",
-    ));
-    assert_close(p[0], Vec3::new(1.0, 2.0, 3.0));
-    assert_close(p[1], Vec3::new(-9.0, 2.0, 3.0));
-    assert_close(p[2], Vec3::new(-19.0, 2.0, 3.0));
-    // XYZ = (90, 90, 90) on (0,0,10): Rz keeps it, Ry → (10,0,0), Rx keeps it.
-    let p = positions(&chain(
-        "3 Xrotation Yrotation Zrotation",
-        "0 0 0 0 0 0 90 90 90",
-    ));
-    assert_close(p[2], Vec3::new(10.0, 10.0, 0.0));
-    // ZX = (90, 90): Rx → (0,-10,0), Rz → (10,0,0).  XZ: Rz keeps it, Rx → (0,-10,0).
-    let p = positions(&chain("2 Zrotation Xrotation", "0 0 0 0 0 0 90 90"));
-    assert_close(p[2], Vec3::new(10.0, 10.0, 0.0));
-    let p = positions(&chain("2 Xrotation Zrotation", "0 0 0 0 0 0 90 90"));
-    assert_close(p[2], Vec3::new(0.0, 0.0, 0.0));
-}
-
-#[test]
-fn fk_position_channels_replace_the_offset() {
-    // Mid has a full 6-channel set: its position (5,0,0) replaces the offset (0,10,0).
-    let text = chain(
-        "6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
-        "0 0 0 0 0 0 5 0 0 0 0 0",
-    );
-    let p = positions(&text);
-    assert_close(p[1], Vec3::new(5.0, 0.0, 0.0));
-    assert_close(p[2], Vec3::new(5.0, 0.0, 10.0));
-    // Only Yposition: X and Z keep the offset's values.
-    let p = positions(&chain("1 Yposition", "0 0 0 0 0 0 -4"));
-    assert_close(p[1], Vec3::new(0.0, -4.0, 0.0));
-}
-
-#[test]
-fn crlf_tabs_exponents_and_glued_braces() {
-    let text = "HIERARCHY\r\nROOT\tRoot{\r\n\tOFFSET 0 0 0\r\n\tCHANNELS 3 Xposition Yposition Zposition \r\n\tEnd Site\r\n\t{\r\n\t\tOFFSET 1.87e-05 1E1 -0\r\n\t}\r\n}\r\nMOTION\r\nFrames:\t2\r\nFrame Time:\t0.0333333\r\n1e-3 2.5E+1 -3\r\n\t0 0 0 \r\n";
-    let bvh = parse(text).unwrap();
-    assert_eq!(bvh.frame_count, 2);
-    assert_eq!(bvh.fps(), 30.0);
-    assert_eq!(bvh.frame(0), [1e-3, 25.0, -3.0]);
-    assert_close(bvh.joints[1].offset, Vec3::new(1.87e-5, 10.0, 0.0));
-    let p = fk::global_positions(&bvh);
-    assert_close(p[1], Vec3::new(1e-3 + 1.87e-5, 35.0, -3.0));
-}
-
-#[test]
-fn joint_names_may_contain_spaces() {
-    let text = "HIERARCHY\nROOT Left Hip Joint\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0\n";
-    assert_eq!(parse(text).unwrap().joints[0].name, "Left Hip Joint");
-}
-
-/// Parses `text` and returns the error's line and kind.
-fn error_of(text: &str) -> (Option<usize>, BvhErrorKind) {
-    let e = parse(text).unwrap_err();
-    assert!(e.to_string().starts_with("t.bvh:"), "{e}");
-    (e.line, e.kind)
-}
-
-#[test]
-fn errors_name_the_line() {
-    let good = chain("3 Zrotation Xrotation Yrotation", "0 0 0 0 0 0 0 0 0");
-    let lines: Vec<&str> = good.lines().collect();
-    let edit = |line: usize, new: &str| -> String {
-        let mut l = lines.clone();
-        l[line - 1] = new;
-        l.join("\n")
-    };
-    use BvhErrorKind as K;
-    // Missing CHANNELS line (line 9) on joint Mid (line 6).
-    let (line, kind) = error_of(&edit(9, ""));
-    assert_eq!((line, kind), (Some(6), K::MissingChannels("Mid".into())));
-    // Fewer channel names than declared.
-    let (line, kind) = error_of(&edit(9, "CHANNELS 3 Zrotation Xrotation"));
-    assert_eq!(
-        (line, kind),
-        (
-            Some(9),
-            K::ChannelCount {
-                declared: 3,
-                found: 2
-            }
-        )
-    );
-    assert_eq!(
-        error_of(&edit(9, "CHANNELS 2 Zrotation Wrotation")),
-        (Some(9), K::UnknownChannel("Wrotation".into()))
-    );
-    assert_eq!(
-        error_of(&edit(8, "OFFSET 0 ten 0")),
-        (Some(8), K::BadNumber("ten".into()))
-    );
-    assert_eq!(
-        error_of(&edit(8, "OFFSET 0 nan 0")),
-        (Some(8), K::NonFinite("nan".into()))
-    );
-    assert_eq!(
-        error_of(&edit(8, "")),
-        (Some(6), K::MissingOffset("Mid".into()))
-    );
-    assert_eq!(
-        error_of(&edit(10, "Bone Site")),
-        (Some(10), K::UnknownKeyword("Bone".into()))
-    );
-    assert_eq!(
-        error_of(&edit(1, "HIERARCHIE")),
-        (Some(1), K::MissingHierarchy("HIERARCHIE".into()))
-    );
-    // Motion section.
-    let (line, kind) = error_of(&edit(19, "0 0 0 0 0 0 0 0"));
-    assert_eq!(
-        (line, kind),
-        (
-            Some(19),
-            K::ValueCount {
-                found: 8,
-                expected: 9
-            }
-        )
-    );
-    assert_eq!(
-        error_of(&edit(19, "0 0 0 0 0 0 0 NaN 0")),
-        (Some(19), K::NonFinite("NaN".into()))
-    );
-    assert_eq!(
-        error_of(&edit(19, "0 0 0 0 0 0 0 inf 0")),
-        (Some(19), K::NonFinite("inf".into()))
-    );
-    assert_eq!(error_of(&edit(17, "Frames: 0")), (Some(17), K::ZeroFrames));
-    assert_eq!(
-        error_of(&edit(17, "Frames: two")),
-        (Some(17), K::BadFrameCount("two".into()))
-    );
-    assert_eq!(
-        error_of(&edit(17, "Frame: 1")),
-        (Some(17), K::MissingHeader("Frames"))
-    );
-    assert_eq!(
-        error_of(&edit(18, "Frame Time: 0")),
-        (Some(18), K::BadFrameTime("0".into()))
-    );
-    assert_eq!(
-        error_of(&edit(17, "Frames: 3")),
-        (
-            Some(19),
-            K::MissingFrames {
-                found: 1,
-                declared: 3
-            }
-        )
-    );
-    let extra = format!("{good}0 0 0 0 0 0 0 0 0\n");
-    assert_eq!(error_of(&extra), (Some(20), K::ExtraFrames { declared: 1 }));
-    let (line, kind) = error_of(&edit(17, "Frames: 100000000"));
-    assert_eq!(line, Some(17));
-    assert!(
-        matches!(
-            kind,
-            K::TooBig {
-                count: 900_000_000,
-                ..
-            }
-        ),
-        "{kind:?}"
-    );
-}
-
-#[test]
-fn truncated_files_are_errors() {
-    let good = chain("3 Zrotation Xrotation Yrotation", "0 0 0 0 0 0 0 0 0");
-    let lines: Vec<&str> = good.lines().collect();
-    // Cut inside the hierarchy: after Mid's CHANNELS line (line 9).
-    let (line, kind) = error_of(&lines[..9].join("\n"));
-    assert_eq!(
-        (line, kind),
-        (Some(9), BvhErrorKind::UnclosedJoint("Mid".into()))
-    );
-    // Cut after the hierarchy.
-    assert_eq!(
-        error_of(&lines[..15].join("\n")),
-        (Some(15), BvhErrorKind::MissingMotion)
-    );
-    // Cut inside the MOTION header.
-    assert_eq!(
-        error_of(&lines[..16].join("\n")),
-        (Some(16), BvhErrorKind::MissingHeader("Frames"))
-    );
-    assert_eq!(
-        error_of(&lines[..17].join("\n")),
-        (Some(17), BvhErrorKind::MissingHeader("Frame Time"))
-    );
-    assert_eq!(
-        error_of(""),
-        (
-            Some(1),
-            BvhErrorKind::MissingHierarchy("end of file".into())
-        )
-    );
-}
-
-#[test]
-fn binary_input_is_refused_through_the_entry_point() {
-    let mut bytes = chain("1 Xrotation", "0 0 0 0 0 0 0").into_bytes();
-    bytes.extend_from_slice(&[0, 159, 146, 150]);
-    let e = import_bvh_bytes("b.bvh", &bytes, &BvhImportOptions::default()).unwrap_err();
-    assert_eq!((e.line, e.kind), (Some(20), BvhErrorKind::Binary));
-}
 
 /// A skeleton from `(name, parent, offset)` rows: root with 6 channels, others 3; an
 /// End Site under every leaf; `frames` frames of zero rotation.
@@ -451,4 +218,32 @@ fn unit_override_and_z_up() {
         import_bvh_str("z.bvh", &text, &bad).unwrap_err().kind,
         BvhErrorKind::BadOption(_)
     ));
+}
+
+#[test]
+fn bandai_named_fixture_uses_the_bandai_table() {
+    // Hand-made, CRLF, tabs; joints named as in the Bandai-Namco dataset, centimetres.
+    let text = include_str!("../../../../tests/fixtures/bandai_like.bvh");
+    let out = import_bvh_str("bandai_like.bvh", text, &BvhImportOptions::default()).unwrap();
+    assert_eq!(out.joint_map.rig, "bandai-namco");
+    assert_eq!(out.joint_map.unused, ["joint_Root"]);
+    assert_eq!(
+        (out.unit_scale, out.source_fps, out.source_frames),
+        (0.01, 30.0, 4)
+    );
+    assert_eq!(out.motion.len(), 3); // 0.1 s at 20 fps
+    let p = out.motion.frames[0];
+    assert_close(p[0], Vec3::new(0.0, 0.95, 0.0));
+    assert_close(p[3], Vec3::new(0.0, 1.05, 0.0));
+    assert_close(p[9], Vec3::new(0.0, 1.20, 0.0));
+    // spine2 at HumanML3D's rest proportion between spine1 and spine3.
+    let t = crate::skeleton::BONE_LENGTHS[6]
+        / (crate::skeleton::BONE_LENGTHS[6] + crate::skeleton::BONE_LENGTHS[9]);
+    assert_close(p[6], Vec3::new(0.0, 1.05 + 0.15 * t, 0.0));
+    assert_close(p[1], Vec3::new(0.09, 0.90, 0.0));
+    // Left leg turned −10° about X: (0,−88,12) cm hip→toe becomes
+    // (0, −88 cos10° + 12 sin10°, 88 sin10° + 12 cos10°) = (0, −84.58, 27.10).
+    assert_close(p[10], Vec3::new(0.09, 0.0542, 0.2710));
+    // Output frame 1 is source frame 1.5: the pelvis has moved 6 cm forward.
+    assert_close(out.motion.frames[1][0], Vec3::new(0.0, 0.95, 0.06));
 }
