@@ -1,1 +1,16 @@
-//! Motion file formats: BVH import/export, `.npy` joint arrays, `.json`.
+//! Motion file formats: BVH import ([`bvh`]), `.npy` joint and feature arrays ([`npy`]),
+//! `.json` documents with reproduction metadata ([`json`]), and one entry point for all
+//! of them ([`read_motion`], [`write_motion`]).
+
+pub mod bvh;
+mod file;
+pub mod json;
+pub mod npy;
+
+#[cfg(test)]
+mod tests;
+
+pub use bvh::{BvhError, BvhImport, BvhImportOptions, import_bvh, import_bvh_str};
+pub use file::{FormatError, LoadedMotion, read_motion, write_motion};
+pub use json::{Meta, Person};
+pub use npy::{MotionFile, NpyArray};

@@ -1,0 +1,174 @@
+//! BVH import: text → joint tree and channels → global positions → the 22 HumanML3D
+//! joints in metres at 20 fps.
+//!
+//! | step | module | in → out |
+//! | --- | --- | --- |
+//! | text | [`text`] | bytes → checked UTF-8, tokens with lines |
+//! | parse | [`parse`], [`hierarchy`], [`frames`] | text → [`Bvh`] |
+//! | kinematics | [`fk`] | [`Bvh`] → global joint positions (file units) |
+//! | retarget | [`names`], [`retarget`] | joint names → [`JointMap`] → 22 joints |
+//! | units | [`units`] | file units / up axis → metres, Y up |
+//!
+//! Entry points: [`import_bvh`] (a file) and [`import_bvh_str`] (text, for tests and
+//! fuzzing). Errors name the input and line ([`BvhError`]).
+
+pub mod error;
+pub mod fk;
+pub mod frames;
+pub mod hierarchy;
+pub mod names;
+pub mod parse;
+pub mod retarget;
+pub mod text;
+pub mod units;
+
+#[cfg(test)]
+mod tests;
+
+pub use error::{BvhError, BvhErrorKind};
+pub use parse::{Bvh, BvhJoint, Channel, ParseLimits, parse_bvh};
+pub use retarget::{JointMap, JointSource};
+pub use units::{Units, UpAxis};
+
+use crate::motion::{Motion, Pose};
+use crate::skeleton::FPS;
+use std::path::Path;
+
+/// How to import a BVH file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhImportOptions {
+    /// File length units (default: detect).
+    pub units: Units,
+    /// Which file axis is up (default: Y).
+    pub up: UpAxis,
+    /// Output frame rate (default: 20, mprog's rate).
+    pub fps: f32,
+    /// Size limits.
+    pub limits: ParseLimits,
+}
+
+impl Default for BvhImportOptions {
+    fn default() -> Self {
+        BvhImportOptions {
+            units: Units::Auto,
+            up: UpAxis::Y,
+            fps: FPS,
+            limits: ParseLimits::default(),
+        }
+    }
+}
+
+/// An imported motion and how it was obtained.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BvhImport {
+    /// The 22 HumanML3D joints, metres, Y up, at [`BvhImportOptions::fps`].
+    pub motion: Motion,
+    /// Frame rate of the file.
+    pub source_fps: f32,
+    /// Frames in the file.
+    pub source_frames: usize,
+    /// Joint map: which rig was recognised and where each joint comes from.
+    pub joint_map: JointMap,
+    /// One readable line per HumanML3D joint (`left_hip ← UpperLeg_L`).
+    pub joint_map_lines: Vec<String>,
+    /// Metres per file unit.
+    pub unit_scale: f32,
+    /// True when [`unit_scale`](Self::unit_scale) was detected rather than given.
+    pub units_detected: bool,
+    /// Things the importer filled in or found odd.
+    pub warnings: Vec<String>,
+}
+
+/// Imports a BVH file.
+pub fn import_bvh(path: &Path, opts: &BvhImportOptions) -> Result<BvhImport, BvhError> {
+    let origin = path.display().to_string();
+    let io = |e: std::io::Error| BvhError::whole(&origin, BvhErrorKind::Io(e.to_string()));
+    let size = std::fs::metadata(path).map_err(io)?.len();
+    // Every value takes at least two bytes of text; a far bigger file cannot be valid.
+    let limit = opts.limits.max_values.saturating_mul(24).max(1 << 20);
+    if size > limit {
+        return Err(BvhError::whole(
+            &origin,
+            BvhErrorKind::FileTooLarge { size, limit },
+        ));
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
+    import_bvh_bytes(&origin, &bytes, opts)
+}
+
+/// Imports BVH bytes; `origin` names them in errors.
+pub fn import_bvh_bytes(
+    origin: &str,
+    bytes: &[u8],
+    opts: &BvhImportOptions,
+) -> Result<BvhImport, BvhError> {
+    let text = text::decode(origin, bytes)?;
+    import_bvh_str(origin, text, opts)
+}
+
+/// Imports BVH text; `origin` names it in errors.
+pub fn import_bvh_str(
+    origin: &str,
+    text: &str,
+    opts: &BvhImportOptions,
+) -> Result<BvhImport, BvhError> {
+    if !(opts.fps.is_finite() && opts.fps > 0.0) {
+        return Err(BvhError::whole(
+            origin,
+            BvhErrorKind::BadOption(format!("output fps must be positive, got {}", opts.fps)),
+        ));
+    }
+    if let Some(s) = opts.units.scale()
+        && !(s.is_finite() && s > 0.0)
+    {
+        return Err(BvhError::whole(
+            origin,
+            BvhErrorKind::BadOption(format!("unit scale must be positive, got {s}")),
+        ));
+    }
+    let bvh = parse_bvh(origin, text, opts.limits)?;
+    let joint_map = retarget::map_joints(&bvh).map_err(|kind| BvhError::whole(origin, kind))?;
+    let source_fps = bvh.fps();
+    // Resampled on the channels, so bones stay rigid (see `fk`).
+    let samples = fk::sample_points(bvh.frame_count, source_fps, opts.fps);
+    let globals = fk::global_positions_at(&bvh, &samples);
+    let joint_count = bvh.joints.len();
+    let file_poses: Vec<Pose> = globals
+        .chunks_exact(joint_count)
+        .map(|g| joint_map.pose(g))
+        .collect();
+
+    let mut warnings = joint_map.warnings.clone();
+    let (unit_scale, units_detected) = match opts.units.scale() {
+        Some(s) => (s, false),
+        None => {
+            let step = (file_poses.len() / 16).max(1);
+            let sample: Vec<Pose> = file_poses.iter().step_by(step).copied().collect();
+            (units::detect_scale(&sample), true)
+        }
+    };
+    let body = units::body_path_length(&file_poses[0]) * unit_scale;
+    if !(0.5..=3.0).contains(&body) {
+        warnings.push(format!(
+            "unusual body size: ankle-to-head bone path is {body:.2} m at {unit_scale} m per file unit; check the units"
+        ));
+    }
+    let frames: Vec<Pose> = file_poses
+        .iter()
+        .map(|pose| pose.map(|p| opts.up.to_y_up(p) * unit_scale))
+        .collect();
+    let motion = Motion {
+        frames,
+        fps: opts.fps,
+    };
+    Ok(BvhImport {
+        motion,
+        source_fps,
+        source_frames: bvh.frame_count,
+        joint_map_lines: joint_map.describe(&bvh),
+        joint_map,
+        unit_scale,
+        units_detected,
+        warnings,
+    })
+}
