@@ -2,7 +2,7 @@
 //!
 //! [`build::build_dataset`] writes it, [`store::Dataset::load`] reads it back.
 
-// pub mod build; (enabled once formats and features land)
+pub mod build;
 pub mod captions;
 pub mod split;
 pub mod stats;
