@@ -57,8 +57,8 @@ mod tests {
         let c = canonicalize(&Motion::new(moved)).unwrap();
         let rest_floor = rest.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
         for t in 0..3 {
-            for j in 0..NUM_JOINTS {
-                let want = rest[j] + Vec3::new(0.0, -rest_floor, 0.1 * t as f32);
+            for (j, r) in rest.iter().enumerate() {
+                let want = *r + Vec3::new(0.0, -rest_floor, 0.1 * t as f32);
                 assert!(
                     (c.frames[t][j] - want).length() < 1e-5,
                     "frame {t} joint {j}"
