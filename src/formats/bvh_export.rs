@@ -161,30 +161,25 @@ pub fn bvh_string(m: &Motion, opts: &BvhExportOptions) -> Result<String, BvhExpo
         .into());
     }
     let poses = ik::poses_f64(m)?;
-    let nodes = hierarchy();
-    let scale = match opts.units {
-        BvhUnits::Metres => 1.0,
-        BvhUnits::Centimetres => 100.0,
+    let writer = Writer {
+        nodes: hierarchy(),
+        lengths: mean_bone_lengths(&poses),
+        scale: match opts.units {
+            BvhUnits::Metres => 1.0,
+            BvhUnits::Centimetres => 100.0,
+        },
+        axes: match opts.axes {
+            BvhAxes::YUp => DQuat::IDENTITY,
+            BvhAxes::BlenderZUp => DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2),
+        },
     };
-    // Axis change applied to every position, offset and rotation.
-    let axes = match opts.axes {
-        BvhAxes::YUp => DQuat::IDENTITY,
-        BvhAxes::BlenderZUp => DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2),
-    };
-    let lengths = mean_bone_lengths(&poses);
-    let offset = |j: usize| axes * DVec3::from(RAW_OFFSETS[j].map(f64::from)) * lengths[j] * scale;
-
     let mut out = String::new();
     write_header(&mut out, m, opts);
-    write_node(&mut out, &nodes, 0, 0, &offset, &lengths, scale, axes);
-    let _ = writeln!(
-        out,
-        "MOTION\nFrames: {}\nFrame Time: {:.8}",
-        poses.len(),
-        1.0 / m.fps as f64
-    );
+    writer.node(&mut out, 0, 0);
+    let _ = writeln!(out, "MOTION\nFrames: {}", poses.len());
+    let _ = writeln!(out, "Frame Time: {:.8}", 1.0 / m.fps as f64);
     for (t, pose) in poses.iter().enumerate() {
-        write_frame(&mut out, &nodes, pose, t, scale, axes)?;
+        writer.frame(&mut out, pose, t)?;
     }
     Ok(out)
 }
@@ -223,86 +218,85 @@ fn write_header(out: &mut String, m: &Motion, opts: &BvhExportOptions) {
     );
 }
 
-#[allow(clippy::too_many_arguments)]
-fn write_node(
-    out: &mut String,
-    nodes: &[Node],
-    id: usize,
-    depth: usize,
-    offset: &dyn Fn(usize) -> DVec3,
-    lengths: &[f64; NUM_JOINTS],
+/// What the writer needs besides the poses: the joints, bone lengths, unit and axes.
+struct Writer {
+    nodes: Vec<Node>,
+    lengths: [f64; NUM_JOINTS],
+    /// Metres → file unit.
     scale: f64,
+    /// Axis change applied to every position, offset and rotation.
     axes: DQuat,
-) {
-    let pad = "  ".repeat(depth);
-    let node = &nodes[id];
-    let kind = if node.parent.is_none() {
-        "ROOT"
-    } else {
-        "JOINT"
-    };
-    let o = node.offset_of.map_or(DVec3::ZERO, offset);
-    let _ = writeln!(out, "{pad}{kind} {}\n{pad}{{", node.name);
-    let _ = writeln!(out, "{pad}  OFFSET {:.6} {:.6} {:.6}", o.x, o.y, o.z);
-    if node.parent.is_none() {
-        let _ = writeln!(
-            out,
-            "{pad}  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation"
-        );
-    } else {
-        let _ = writeln!(out, "{pad}  CHANNELS 3 Zrotation Yrotation Xrotation");
-    }
-    for &c in &node.children {
-        write_node(out, nodes, c, depth + 1, offset, lengths, scale, axes);
-    }
-    if node.children.is_empty() {
-        // Leaves continue their bone by half its length (BVH needs an end site).
-        let j = node.offset_of.unwrap_or(0);
-        let e = axes * DVec3::from(RAW_OFFSETS[j].map(f64::from)) * lengths[j] * 0.5 * scale;
-        let _ = writeln!(
-            out,
-            "{pad}  End Site\n{pad}  {{\n{pad}    OFFSET {:.6} {:.6} {:.6}\n{pad}  }}",
-            e.x, e.y, e.z
-        );
-    }
-    let _ = writeln!(out, "{pad}}}");
 }
 
-/// One MOTION line: root position, then every joint's local Z, Y, X rotation in degrees.
-fn write_frame(
-    out: &mut String,
-    nodes: &[Node],
-    pose: &Pose64,
-    frame: usize,
-    scale: f64,
-    axes: DQuat,
-) -> Result<(), FeatureError> {
-    let facing = ik::body_facing(pose, frame)?;
-    let bones = ik::chained_bone_rotations(pose, frame, facing)?;
-    let mut global = vec![DQuat::IDENTITY; nodes.len()];
-    let root = axes * pose[0] * scale;
-    let mut line = format!("{:.6} {:.6} {:.6}", root.x, root.y, root.z);
-    for (id, node) in nodes.iter().enumerate() {
-        let parent = node.parent.map_or(DQuat::IDENTITY, |p| global[p]);
-        global[id] = match node.carry {
-            Carry::Facing => axes * facing * axes.inverse(),
-            Carry::Bone(b) => axes * bones[b] * axes.inverse(),
-            Carry::Inherit => parent,
-        };
-        let (z, y, x) = (parent.inverse() * global[id])
-            .normalize()
-            .to_euler(EulerRot::ZYX);
-        let _ = write!(
-            line,
-            " {:.6} {:.6} {:.6}",
-            z.to_degrees(),
-            y.to_degrees(),
-            x.to_degrees()
-        );
+impl Writer {
+    /// `fraction` × the rest offset of HumanML3D joint `j`, in file units and axes.
+    fn offset(&self, j: usize, fraction: f64) -> DVec3 {
+        let raw = DVec3::from(RAW_OFFSETS[j].map(f64::from));
+        self.axes * raw * (self.lengths[j] * fraction * self.scale)
     }
-    out.push_str(&line);
-    out.push('\n');
-    Ok(())
+
+    /// Writes the HIERARCHY entry of node `id` and its subtree.
+    fn node(&self, out: &mut String, id: usize, depth: usize) {
+        let pad = "  ".repeat(depth);
+        let node = &self.nodes[id];
+        let o = node.offset_of.map_or(DVec3::ZERO, |j| self.offset(j, 1.0));
+        let kind = if node.parent.is_none() {
+            "ROOT"
+        } else {
+            "JOINT"
+        };
+        let _ = writeln!(out, "{pad}{kind} {}\n{pad}{{", node.name);
+        let _ = writeln!(out, "{pad}  OFFSET {:.6} {:.6} {:.6}", o.x, o.y, o.z);
+        let channels = if node.parent.is_none() {
+            "6 Xposition Yposition Zposition Zrotation Yrotation Xrotation"
+        } else {
+            "3 Zrotation Yrotation Xrotation"
+        };
+        let _ = writeln!(out, "{pad}  CHANNELS {channels}");
+        for &c in &node.children {
+            self.node(out, c, depth + 1);
+        }
+        if node.children.is_empty() {
+            // Leaves continue their bone by half its length (BVH needs an end site).
+            let e = self.offset(node.offset_of.unwrap_or(0), 0.5);
+            let _ = writeln!(out, "{pad}  End Site\n{pad}  {{");
+            let _ = writeln!(
+                out,
+                "{pad}    OFFSET {:.6} {:.6} {:.6}\n{pad}  }}",
+                e.x, e.y, e.z
+            );
+        }
+        let _ = writeln!(out, "{pad}}}");
+    }
+
+    /// One MOTION line: root position, then every joint's local Z, Y, X rotation in degrees.
+    fn frame(&self, out: &mut String, pose: &Pose64, frame: usize) -> Result<(), FeatureError> {
+        let facing = ik::body_facing(pose, frame)?;
+        let bones = ik::chained_bone_rotations(pose, frame, facing)?;
+        let to_file = |q: DQuat| self.axes * q * self.axes.inverse();
+        let mut global = vec![DQuat::IDENTITY; self.nodes.len()];
+        let root = self.axes * pose[0] * self.scale;
+        let _ = write!(out, "{:.6} {:.6} {:.6}", root.x, root.y, root.z);
+        for (id, node) in self.nodes.iter().enumerate() {
+            let parent = node.parent.map_or(DQuat::IDENTITY, |p| global[p]);
+            global[id] = match node.carry {
+                Carry::Facing => to_file(facing),
+                Carry::Bone(b) => to_file(bones[b]),
+                Carry::Inherit => parent,
+            };
+            let local = (parent.inverse() * global[id]).normalize();
+            let (z, y, x) = local.to_euler(EulerRot::ZYX);
+            let _ = write!(
+                out,
+                " {:.6} {:.6} {:.6}",
+                z.to_degrees(),
+                y.to_degrees(),
+                x.to_degrees()
+            );
+        }
+        out.push('\n');
+        Ok(())
+    }
 }
 
 #[cfg(test)]
