@@ -101,6 +101,23 @@ fn synthetic_walk_round_trips_within_a_millimetre() {
 }
 
 #[test]
+fn features_ignore_where_the_clip_starts_and_which_way_it_faces() {
+    let walk = synthetic_walk(50);
+    let turn = glam::Quat::from_rotation_y(-2.5);
+    let shift = glam::Vec3::new(-4.0, 0.3, 7.5);
+    let moved = Motion::new(
+        walk.frames
+            .iter()
+            .map(|p| p.map(|v| turn * v + shift))
+            .collect(),
+    );
+    let a = extract(&walk, &ExtractOptions::default()).unwrap();
+    let b = extract(&moved, &ExtractOptions::default()).unwrap();
+    let (max, _) = block_error(&a, b.as_slice(), 0..FEATURE_DIM);
+    assert!(max < 1e-5, "max feature difference {max}");
+}
+
+#[test]
 fn uniform_skeleton_option_retargets_a_larger_body() {
     let walk = synthetic_walk(60);
     let big = Motion::new(walk.frames.iter().map(|p| p.map(|v| v * 1.2)).collect());

@@ -1,5 +1,6 @@
 //! `mprog bench`: timing tables (medians over repeated runs) printed as markdown.
 
+use burn::prelude::*;
 use miette::Result;
 use mprog::model::denoiser::{Denoiser, DenoiserInput, Mdm};
 use mprog::model::noise::NoiseSource;
@@ -7,7 +8,6 @@ use mprog::model::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
 use mprog::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use mprog::model::text::{TokenBatch, Vocabulary};
 use mprog::model::{ModelBundle, ModelConfig};
-use burn::prelude::*;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -55,7 +55,10 @@ fn median_ms(reps: usize, mut f: impl FnMut()) -> f64 {
 
 fn bench_model(args: ModelBenchArgs) -> Result<()> {
     let plain = Device::flex();
-    let dir = args.model.clone().unwrap_or_else(mprog::model::weights::default_model_dir);
+    let dir = args
+        .model
+        .clone()
+        .unwrap_or_else(mprog::model::weights::default_model_dir);
     let (config, vocab, model) = match ModelBundle::load(&dir, &plain) {
         Ok(b) => (b.config, b.vocab, b.model),
         Err(e) => {
@@ -92,7 +95,10 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
             })
         })
         .collect();
-    println!("| forward (inference) | {:.1} ms | {:.1} ms |", fwd[0], fwd[1]);
+    println!(
+        "| forward (inference) | {:.1} ms | {:.1} ms |",
+        fwd[0], fwd[1]
+    );
     let ad = plain.clone().autodiff();
     let train = model.clone().to_device(&ad);
     let fb: Vec<f64> = [1, 32]
@@ -105,7 +111,10 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
             })
         })
         .collect();
-    println!("| forward + backward (training) | {:.1} ms | {:.1} ms |", fb[0], fb[1]);
+    println!(
+        "| forward + backward (training) | {:.1} ms | {:.1} ms |",
+        fb[0], fb[1]
+    );
     let base = NoiseSchedule::cosine(DIFFUSION_STEPS);
     let cond = Condition::new(&vocab, &["a person walks forward"], 2.5, &plain);
     for steps in [50, 100] {
@@ -113,9 +122,21 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
         let s = schedule_for(&base, kind);
         let ms = median_ms(1.max(args.reps / 2), || {
             let x = NoiseSource::new(1).tensor([1, n, config.features], &plain);
-            let _ = sample_chain(&inference, &s, kind, x, &cond, &mut NoiseSource::new(2), |_, _| {}).into_data();
+            let _ = sample_chain(
+                &inference,
+                &s,
+                kind,
+                x,
+                &cond,
+                &mut NoiseSource::new(2),
+                |_, _| {},
+            )
+            .into_data();
         });
-        println!("| DDIM {steps} steps, CFG 2.5 (1 motion) | {:.2} s | |", ms / 1e3);
+        println!(
+            "| DDIM {steps} steps, CFG 2.5 (1 motion) | {:.2} s | |",
+            ms / 1e3
+        );
     }
     Ok(())
 }

@@ -49,8 +49,15 @@ fn build(args: BuildArgs) -> Result<()> {
     for (path, reason) in &index.skipped {
         eprintln!("skipped {path}: {reason}");
     }
-    println!("built {} in {:.1} s", args.out.display(), index.build_seconds);
-    println!("{:6} {:>6} {:>9} {:>7}", "split", "clips", "frames", "hours");
+    println!(
+        "built {} in {:.1} s",
+        args.out.display(),
+        index.build_seconds
+    );
+    println!(
+        "{:6} {:>6} {:>9} {:>7}",
+        "split", "clips", "frames", "hours"
+    );
     for (name, s) in ["train", "val", "test"].iter().zip(&index.stats) {
         println!("{name:6} {:>6} {:>9} {:>7.3}", s.clips, s.frames, s.hours);
     }

@@ -1,5 +1,5 @@
 //! Subcommands of the `mprog` binary, one file each.
 
-pub mod train;
-pub mod data;
 pub mod bench;
+pub mod data;
+pub mod train;

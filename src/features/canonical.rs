@@ -7,10 +7,9 @@
 //!   across = (r_hip − l_hip) + (r_sh − l_sh) (the correct rule, not the per-frame quirk).
 
 use super::FeatureError;
-use super::ik::{Pose64, motion_from_f64, poses_f64, rotation_between};
+use super::ik::{self, Pose64, motion_from_f64, poses_f64};
 use crate::motion::Motion;
-use crate::skeleton::FACE_JOINTS;
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 
 /// Puts a clip on the floor, its frame-0 root above the origin, facing +Z at frame 0.
 ///
@@ -32,29 +31,13 @@ pub(crate) fn canonicalize_f64(mut poses: Vec<Pose64>) -> Result<Vec<Pose64>, Fe
         .map(|p| p.y)
         .fold(f64::INFINITY, f64::min);
     let shift = DVec3::new(first[0].x, floor, first[0].z);
-    let turn = initial_facing_turn(first)?;
+    let turn = ik::body_facing(first, 0)?.inverse();
     for pose in &mut poses {
         for p in pose.iter_mut() {
             *p = turn * (*p - shift);
         }
     }
     Ok(poses)
-}
-
-/// The yaw rotation taking the facing direction of `pose` to +Z.
-fn initial_facing_turn(pose: &Pose64) -> Result<DQuat, FeatureError> {
-    let [r_hip, l_hip, r_sh, l_sh] = FACE_JOINTS;
-    let across = (pose[r_hip] - pose[l_hip]) + (pose[r_sh] - pose[l_sh]);
-    let across = across
-        .try_normalize()
-        .ok_or(FeatureError::DegenerateFacing { frame: 0 })?;
-    let forward = DVec3::Y.cross(across);
-    // Nearly vertical across vectors leave no reliable horizontal facing.
-    let forward = forward
-        .try_normalize()
-        .filter(|_| forward.length() > 1e-6)
-        .ok_or(FeatureError::DegenerateFacing { frame: 0 })?;
-    Ok(rotation_between(forward, DVec3::Z))
 }
 
 #[cfg(test)]
@@ -74,8 +57,8 @@ mod tests {
         let c = canonicalize(&Motion::new(moved)).unwrap();
         let rest_floor = rest.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
         for t in 0..3 {
-            for j in 0..NUM_JOINTS {
-                let want = rest[j] + Vec3::new(0.0, -rest_floor, 0.1 * t as f32);
+            for (j, r) in rest.iter().enumerate() {
+                let want = *r + Vec3::new(0.0, -rest_floor, 0.1 * t as f32);
                 assert!(
                     (c.frames[t][j] - want).length() < 1e-5,
                     "frame {t} joint {j}"

@@ -42,6 +42,14 @@ pub enum FeatureError {
         /// Frame index.
         frame: usize,
     },
+    /// Features are defined per frame at 20 fps; other rates must be resampled first.
+    #[error(
+        "the motion runs at {fps} fps; HumanML3D features need 20 fps (resample it with Motion::resample)"
+    )]
+    WrongFps {
+        /// Frame rate of the motion.
+        fps: f32,
+    },
     /// A flat feature array whose length is not a multiple of the feature width.
     #[error("feature array of length {len} is not a whole number of {dim}-wide frames")]
     BadFeatureLength {

@@ -18,7 +18,7 @@ use super::ik::{self, Pose64};
 use super::layout::{FEATURE_DIM, Features};
 use super::retarget::uniform_skeleton_f64;
 use crate::motion::Motion;
-use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT, NUM_JOINTS};
+use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT, FPS, NUM_JOINTS};
 use glam::{DQuat, DVec3};
 
 /// Squared per-frame displacement (m²) below which a foot joint is in contact.
@@ -34,12 +34,18 @@ pub struct ExtractOptions {
 }
 
 /// Extracts HumanML3D features: F frames in, F − 1 feature frames out.
+///
+/// Errors: fewer than 2 frames, a frame rate other than 20 fps, non-finite coordinates,
+/// zero-length bones, or hips and shoulders that give no facing direction.
 pub fn extract(m: &Motion, opts: &ExtractOptions) -> Result<Features, FeatureError> {
     if m.len() < 2 {
         return Err(FeatureError::TooFewFrames {
             frames: m.len(),
             needed: 2,
         });
+    }
+    if (m.fps - FPS).abs() > 1e-3 {
+        return Err(FeatureError::WrongFps { fps: m.fps });
     }
     let mut poses = ik::poses_f64(m)?;
     if opts.uniform_skeleton {

@@ -78,6 +78,28 @@ pub fn rotation_between(from: DVec3, to: DVec3) -> DQuat {
     DQuat::from_xyzw(c.x, c.y, c.z, w).normalize()
 }
 
+/// The yaw (rotation about +Y) taking the horizontal direction `forward` to +Z. For a
+/// horizontal vector this is HumanML3D's `qbetween(forward, +Z)`; written as a yaw it stays a
+/// yaw even when `forward` is exactly −Z.
+pub fn yaw_to_face_z(forward: DVec3) -> DQuat {
+    DQuat::from_rotation_y(-forward.x.atan2(forward.z))
+}
+
+/// The body's facing in one pose by the canonical rule: across = (r_hip − l_hip) +
+/// (r_sh − l_sh), forward = normalise(up × across). Returns the yaw taking +Z to forward.
+///
+/// `frame` is only used for the error message of a degenerate facing.
+pub fn body_facing(pose: &Pose64, frame: usize) -> Result<DQuat, FeatureError> {
+    let [r_hip, l_hip, r_sh, l_sh] = FACE_JOINTS;
+    let across = (pose[r_hip] - pose[l_hip]) + (pose[r_sh] - pose[l_sh]);
+    let forward = DVec3::Y.cross(across.try_normalize().unwrap_or(DVec3::ZERO));
+    // Nearly vertical across vectors leave no reliable horizontal facing.
+    if forward.length() < 1e-6 {
+        return Err(FeatureError::DegenerateFacing { frame });
+    }
+    Ok(yaw_to_face_z(forward).inverse())
+}
+
 /// Global rotation of every bone of one pose (index = child joint; `[0]` is the identity):
 /// the minimal rotation from the rest direction to the current direction.
 ///
@@ -94,6 +116,37 @@ pub fn bone_rotations(pose: &Pose64, frame: usize) -> Result<[DQuat; NUM_JOINTS]
             });
         }
         g[j] = rotation_between(DVec3::from(RAW_OFFSETS[j].map(f64::from)), bone);
+    }
+    Ok(g)
+}
+
+/// Global bone rotations with no twist relative to the parent bone (for export formats
+/// with one rotation per joint, e.g. BVH): each bone's rotation is its parent bone's rotation
+/// followed by the minimal swing taking the so-turned rest direction to the current one;
+/// `root` (e.g. [`body_facing`]) orients the bones leaving the root. Every entry still takes
+/// its bone's rest direction to its current direction, like [`bone_rotations`], but the
+/// rotations follow the body (a turned rest pose gets the turn on every bone) instead of
+/// being minimal arcs from the unturned rest pose. `[0]` is `root`.
+pub fn chained_bone_rotations(
+    pose: &Pose64,
+    frame: usize,
+    root: DQuat,
+) -> Result<[DQuat; NUM_JOINTS], FeatureError> {
+    let mut g = [DQuat::IDENTITY; NUM_JOINTS];
+    g[0] = root;
+    // Parents come before their children in HumanML3D's joint order.
+    for j in 1..NUM_JOINTS {
+        let bone = pose[j] - pose[PARENTS[j]];
+        if bone.length() < MIN_LENGTH {
+            return Err(FeatureError::ZeroBone {
+                frame,
+                joint: j,
+                name: JOINT_NAMES[j],
+            });
+        }
+        let base = g[PARENTS[j]];
+        let rest = base * DVec3::from(RAW_OFFSETS[j].map(f64::from));
+        g[j] = rotation_between(rest, bone) * base;
     }
     Ok(g)
 }
@@ -140,9 +193,10 @@ pub fn root_rotations(poses: &[Pose64], smooth: bool) -> Result<Vec<DQuat>, Feat
             if frame == 0 {
                 return Ok(DQuat::IDENTITY);
             }
-            let f = f.try_normalize().filter(|f| f.length() > 0.5);
-            let f = f.ok_or(FeatureError::DegenerateFacing { frame })?;
-            Ok(rotation_between(f, DVec3::Z))
+            if f.length() < 1e-9 {
+                return Err(FeatureError::DegenerateFacing { frame });
+            }
+            Ok(yaw_to_face_z(*f))
         })
         .collect()
 }
@@ -273,6 +327,25 @@ mod tests {
         }
         let r = root_rotations(&[rest, wide], false).unwrap();
         assert!((r[1] * (turn * DVec3::Z) + DVec3::Z).length() < 1e-9);
+    }
+
+    #[test]
+    fn chained_rotations_follow_the_body() {
+        // A rest pose turned by 3 rad (nearly facing -Z, where minimal arcs degenerate).
+        let turn = DQuat::from_rotation_y(3.0);
+        let turned = pose64(&rest_pose()).map(|v| turn * v);
+        let facing = body_facing(&turned, 0).unwrap();
+        assert!(facing.abs_diff_eq(turn, 1e-9));
+        for g in chained_bone_rotations(&turned, 0, facing).unwrap() {
+            assert!(g.abs_diff_eq(turn, 1e-9) || g.abs_diff_eq(-turn, 1e-9));
+        }
+        let p = bent_pose();
+        let g = chained_bone_rotations(&p, 0, DQuat::from_rotation_y(0.3)).unwrap();
+        for j in 1..NUM_JOINTS {
+            let dir = (p[j] - p[PARENTS[j]]).normalize();
+            let rest = DVec3::from(RAW_OFFSETS[j].map(f64::from));
+            assert!((g[j] * rest - dir).length() < 1e-9, "joint {j}");
+        }
     }
 
     #[test]

@@ -43,7 +43,7 @@ pub struct Features {
 impl Features {
     /// Wraps a flat `[frames, 263]` array; its length must be a multiple of 263.
     pub fn from_vec(data: Vec<f32>) -> Result<Self, FeatureError> {
-        if data.len() % FEATURE_DIM != 0 {
+        if !data.len().is_multiple_of(FEATURE_DIM) {
             return Err(FeatureError::BadFeatureLength {
                 len: data.len(),
                 dim: FEATURE_DIM,

@@ -28,7 +28,7 @@ pub(crate) fn check_stats(mean: &[f32], std: &[f32]) -> Result<(), FeatureError>
 }
 
 fn check_data(data: &[f32]) -> Result<(), FeatureError> {
-    if data.len() % FEATURE_DIM != 0 {
+    if !data.len().is_multiple_of(FEATURE_DIM) {
         return Err(FeatureError::BadFeatureLength {
             len: data.len(),
             dim: FEATURE_DIM,

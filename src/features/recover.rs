@@ -17,7 +17,7 @@ use glam::Vec3;
 
 /// Joint positions from de-normalised features (flat `[frames, 263]`).
 pub fn recover_from_ric(features: &[f32]) -> Result<Motion, FeatureError> {
-    if features.len() % FEATURE_DIM != 0 {
+    if !features.len().is_multiple_of(FEATURE_DIM) {
         return Err(FeatureError::BadFeatureLength {
             len: features.len(),
             dim: FEATURE_DIM,

@@ -1,8 +1,9 @@
-//! Motion file formats: BVH import ([`bvh`]), `.npy` joint and feature arrays ([`npy`]),
-//! `.json` documents with reproduction metadata ([`json`]), and one entry point for all
-//! of them ([`read_motion`], [`write_motion`]).
+//! Motion file formats: BVH import ([`bvh`]) and export ([`bvh_export`]), `.npy` joint and
+//! feature arrays ([`npy`]), `.json` documents with reproduction metadata ([`json`]), and
+//! one entry point for all of them ([`read_motion`], [`write_motion`]).
 
 pub mod bvh;
+pub mod bvh_export;
 mod file;
 pub mod json;
 pub mod npy;

@@ -56,7 +56,7 @@ pub fn initial_noise(req: &GenerateRequest, features: usize, device: &Device) ->
 
 /// De-normalises `[B, N, F]` model-space samples to host feature rows.
 pub fn denormalize_host(bundle: &ModelBundle, x: Tensor<3>) -> Vec<f32> {
-    let mut data = x.into_data().to_vec::<f32>().expect("f32 tensor");
+    let mut data = x.into_data().into_vec::<f32>().expect("f32 tensor");
     let f = bundle.config.features;
     for row in data.chunks_exact_mut(f) {
         for (i, v) in row.iter_mut().enumerate() {
