@@ -69,7 +69,9 @@ pub fn find_bvh_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
-        let Ok(entries) = std::fs::read_dir(&d) else { continue };
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
         for e in entries.flatten() {
             let p = e.path();
             if p.is_dir() {
@@ -106,16 +108,27 @@ fn to_clip(
     labels: &Labels,
     mirrored: bool,
 ) -> Result<Converted, String> {
-    let features = extract(motion, &ExtractOptions { uniform_skeleton: true }).map_err(|e| e.to_string())?;
+    let features = extract(
+        motion,
+        &ExtractOptions {
+            uniform_skeleton: true,
+        },
+    )
+    .map_err(|e| e.to_string())?;
     let frames = features.frames();
     let features = features.into_vec();
     if features.iter().any(|v| !v.is_finite()) {
         return Err("features contain NaN or infinite values".into());
     }
-    let joints = recover_from_ric(&features).map_err(|e| e.to_string())?.to_flat();
+    let joints = recover_from_ric(&features)
+        .map_err(|e| e.to_string())?
+        .to_flat();
     let caps = captions(labels);
     if caps.is_empty() {
-        return Err(format!("no captions for the motion label `{}`", labels.content));
+        return Err(format!(
+            "no captions for the motion label `{}`",
+            labels.content
+        ));
     }
     Ok(Converted {
         info: ClipInfo {
@@ -136,13 +149,25 @@ fn to_clip(
 
 /// Converts one file into its clip (and mirrored clip).
 fn convert_file(path: &Path, root: &Path, opts: &BuildOptions) -> Result<Vec<Converted>, String> {
-    let source = path.strip_prefix(root).unwrap_or(path).to_string_lossy().to_string();
-    let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
-    let labels = parse_labels(&stem).ok_or_else(|| format!("file name `{stem}` has no `dataset-N_content_style_id` labels"))?;
+    let source = path
+        .strip_prefix(root)
+        .unwrap_or(path)
+        .to_string_lossy()
+        .to_string();
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let labels = parse_labels(&stem)
+        .ok_or_else(|| format!("file name `{stem}` has no `dataset-N_content_style_id` labels"))?;
     let import = import_bvh(path, &BvhImportOptions::default()).map_err(|e| e.to_string())?;
     let motion = import.motion;
     if motion.len() < opts.min_frames + 1 {
-        return Err(format!("only {} frames at 20 fps (need {})", motion.len(), opts.min_frames + 1));
+        return Err(format!(
+            "only {} frames at 20 fps (need {})",
+            motion.len(),
+            opts.min_frames + 1
+        ));
     }
     let mut out = vec![to_clip(&motion, stem.clone(), &source, &labels, false)?];
     if opts.mirror {
@@ -150,7 +175,13 @@ fn convert_file(path: &Path, root: &Path, opts: &BuildOptions) -> Result<Vec<Con
             content: mirror_content(&labels.content),
             style: labels.style.clone(),
         };
-        out.push(to_clip(&mirror_motion(&motion), format!("{stem}_mirror"), &source, &mirrored, true)?);
+        out.push(to_clip(
+            &mirror_motion(&motion),
+            format!("{stem}_mirror"),
+            &source,
+            &mirrored,
+            true,
+        )?);
     }
     Ok(out)
 }
@@ -193,7 +224,10 @@ pub fn build_dataset(
         }
     }
     if clips.is_empty() {
-        let first = skipped.first().map(|s| format!("{}: {}", s.0, s.1)).unwrap_or_default();
+        let first = skipped
+            .first()
+            .map(|s| format!("{}: {}", s.0, s.1))
+            .unwrap_or_default();
         return Err(BuildError::NothingConverted(files.len(), first));
     }
     let train_rows: Vec<&[f32]> = clips
@@ -203,7 +237,11 @@ pub fn build_dataset(
         .collect();
     let (mean, std) = feature_stats(&train_rows);
     let stats = [Split::Train, Split::Val, Split::Test].map(|s| {
-        let frames: usize = clips.iter().filter(|c| c.split == s).map(|c| c.frames).sum();
+        let frames: usize = clips
+            .iter()
+            .filter(|c| c.split == s)
+            .map(|c| c.frames)
+            .sum();
         SplitStats {
             clips: clips.iter().filter(|c| c.split == s).count(),
             frames,
@@ -234,7 +272,10 @@ fn write_dataset(
         let path = path.to_path_buf();
         move |source| BuildError::Write { path, source }
     };
-    let name = out.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_else(|| "dataset".into());
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| "dataset".into());
     let staging = out.with_file_name(format!(".{name}.building"));
     if staging.exists() {
         std::fs::remove_dir_all(&staging).map_err(werr(&staging))?;

@@ -56,7 +56,7 @@ pub fn initial_noise(req: &GenerateRequest, features: usize, device: &Device) ->
 
 /// De-normalises `[B, N, F]` model-space samples to host feature rows.
 pub fn denormalize_host(bundle: &ModelBundle, x: Tensor<3>) -> Vec<f32> {
-    let mut data = x.into_data().into_vec::<f32>().expect("f32 tensor");
+    let mut data = x.into_data().try_into_vec::<f32>().expect("f32 tensor");
     let f = bundle.config.features;
     for row in data.chunks_exact_mut(f) {
         for (i, v) in row.iter_mut().enumerate() {
@@ -90,7 +90,15 @@ pub fn generate(
     let schedule = schedule_for(&NoiseSchedule::cosine(DIFFUSION_STEPS), req.sampler);
     let x_t = initial_noise(req, bundle.config.features, device);
     let mut noise = NoiseSource::new(req.seed ^ 0x5DEE_CE66);
-    let x0 = sample_chain(&model, &schedule, req.sampler, x_t, &cond, &mut noise, on_step);
+    let x0 = sample_chain(
+        &model,
+        &schedule,
+        req.sampler,
+        x_t,
+        &cond,
+        &mut noise,
+        on_step,
+    );
     let features = denormalize_host(bundle, x0);
     if features.iter().any(|v| !v.is_finite()) {
         return Err(GenerateError::NonFinite);
