@@ -91,19 +91,26 @@ pub fn read_motion(path: &Path) -> Result<LoadedMotion, FormatError> {
     }
 }
 
-/// Writes motions (one per person) as `.npy` or `.json`; `meta` goes into JSON only,
-/// since `.npy` holds a bare array.
+/// Writes motions (one per person) as `.npy`, `.json` or `.bvh` (one person, Y up,
+/// metres); `meta` goes into JSON only, since `.npy` and BVH hold no free-form fields.
 pub fn write_motion(path: &Path, motions: &[Motion], meta: &Meta) -> Result<(), FormatError> {
     match extension(path).as_str() {
         "npy" => Ok(write_joints_npy(path, motions)?),
         "json" => Ok(write_json(path, &default_names(motions.to_vec()), meta)?),
-        "bvh" => Err(unsupported(
-            path,
-            "BVH export is not implemented yet; write .npy or .json".into(),
-        )),
+        "bvh" => match motions {
+            [one] => super::bvh_export::write_bvh(path, one, &Default::default())
+                .map_err(|e| unsupported(path, e.to_string())),
+            _ => Err(unsupported(
+                path,
+                format!(
+                    "a BVH file holds one skeleton but there are {} people; write one .bvh per person or use .json/.npy",
+                    motions.len()
+                ),
+            )),
+        },
         other => Err(unsupported(
             path,
-            format!("cannot write `.{other}` files: expected .npy or .json"),
+            format!("cannot write `.{other}` files: expected .npy, .json or .bvh"),
         )),
     }
 }
