@@ -38,13 +38,56 @@ pub(crate) fn line(area: &Area, a: Px, b: Px, color: RGBColor, width: u32) -> Re
     polyline(area, vec![a, b], color, width)
 }
 
+/// A translucent filled polygon (`alpha` of `color` over what is there).
+pub(crate) fn veil(area: &Area, points: Vec<Px>, color: RGBColor, alpha: f64) -> Result<(), RenderError> {
+    area.draw(&Polygon::new(points, color.mix(alpha).filled())).map_err(draw_err)
+}
+
 /// A connected line through `points`.
+///
+/// Plotters fills thick paths as one mitred polygon, which spikes at sharp turns and
+/// near-zero segments (a shadow's spine seen from above is such a path), and its polygon
+/// fill leaves bumps on short thick segments. So: 1 px lines go straight to plotters;
+/// 2 px lines are two parallel 1 px lines; wider ones are drawn segment by segment with
+/// round joins, after merging points closer together than the stroke is wide.
 pub(crate) fn polyline(area: &Area, points: Vec<Px>, color: RGBColor, width: u32) -> Result<(), RenderError> {
-    if points.len() < 2 {
+    if points.len() < 2 || width == 0 {
         return Ok(());
     }
-    area.draw(&PathElement::new(points, color.stroke_width(width)))
-        .map_err(draw_err)
+    let thin = |pts: Vec<Px>| area.draw(&PathElement::new(pts, color.stroke_width(1))).map_err(draw_err);
+    match width {
+        1 => thin(points),
+        2 => {
+            for pair in points.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                let (dx, dy) = if (b.0 - a.0).abs() >= (b.1 - a.1).abs() { (0, 1) } else { (1, 0) };
+                thin(vec![a, b])?;
+                thin(vec![(a.0 + dx, a.1 + dy), (b.0 + dx, b.1 + dy)])?;
+            }
+            Ok(())
+        }
+        _ => {
+            let near = |a: Px, b: Px| (a.0 - b.0).pow(2) + (a.1 - b.1).pow(2) < (width * width) as i32;
+            let last = points[points.len() - 1];
+            let mut kept = vec![points[0]];
+            for &p in &points[1..points.len() - 1] {
+                if !near(p, kept[kept.len() - 1]) && !near(p, last) {
+                    kept.push(p);
+                }
+            }
+            kept.push(last);
+            for (k, pair) in kept.windows(2).enumerate() {
+                if pair[0] != pair[1] {
+                    area.draw(&PathElement::new(vec![pair[0], pair[1]], color.stroke_width(width)))
+                        .map_err(draw_err)?;
+                }
+                if k + 2 < kept.len() {
+                    disc(area, pair[1], (width as i32) / 2, color)?;
+                }
+            }
+            Ok(())
+        }
+    }
 }
 
 /// A filled circle.

@@ -3,7 +3,7 @@
 //! and overlay lines and dots.
 
 use super::camera::View;
-use super::draw::{Area, CENTRE, TOP_LEFT, disc, line, polygon, polyline, ring, text};
+use super::draw::{Area, CENTRE, TOP_LEFT, disc, line, polygon, polyline, ring, text, veil};
 use super::error::RenderError;
 use super::overlay_geom::Prim;
 use super::scene::Scene;
@@ -64,7 +64,9 @@ pub(crate) fn draw_metre_labels(area: &Area, scene: &Scene, view: &View, size: f
         let mut v = (lo / step).ceil() * step;
         while v <= hi + 1e-4 {
             let (x, y) = view.pxf(axis * v);
-            let label = format!("{}", v.round() as i64);
+            // `axis` is ±X or ±Z: the label is the world coordinate, not the projection.
+            let sign = axis.x + axis.y + axis.z;
+            let label = format!("{}", (v * sign).round() as i64);
             if horizontal {
                 let at = (x.round() as i32, bottom.round() as i32 + 2);
                 text(area, &label, at, size, SUBTLE, (HPos::Center, VPos::Top))?;
@@ -104,11 +106,27 @@ pub(crate) fn draw_shadows(area: &Area, scene: &Scene, view: &View, frame: usize
     Ok(())
 }
 
-/// Overlay lines (planes, boxes, segments).
-pub(crate) fn draw_overlay_lines(area: &Area, scene: &Scene, view: &View) -> Result<(), RenderError> {
+/// Overlay lines and planes (planes as a light veil with an outline, so a wall reads as
+/// a surface; boxes and segments as lines). A plane seen edge-on or face-on from straight
+/// above (the top view) is a line or the whole floor: `from_above` draws walls as lines
+/// and leaves horizontal planes out.
+pub(crate) fn draw_overlay_lines(area: &Area, scene: &Scene, view: &View, from_above: bool) -> Result<(), RenderError> {
     for prim in &scene.prims {
-        if let Prim::Line(a, b) = prim {
-            line(area, view.px(*a), view.px(*b), OVERLAY, 2)?;
+        match prim {
+            Prim::Line(a, b) => line(area, view.px(*a), view.px(*b), OVERLAY, 2)?,
+            Prim::Quad(q) if from_above => {
+                // A wall's bottom edge is its trace on the map; a horizontal plane has none.
+                if (q[2].y - q[1].y).abs() > 1e-6 {
+                    line(area, view.px(q[0]), view.px(q[1]), OVERLAY, 2)?;
+                }
+            }
+            Prim::Quad(q) => {
+                let mut pts: Vec<_> = q.iter().map(|p| view.px(*p)).collect();
+                veil(area, pts.clone(), OVERLAY, 0.08)?;
+                pts.push(pts[0]);
+                polyline(area, pts, OVERLAY, 1)?;
+            }
+            Prim::Dot(..) => {}
         }
     }
     Ok(())

@@ -11,7 +11,8 @@ use std::ops::Range;
 pub struct RenderOptions {
     /// Caption drawn at the top (e.g. the prompt); empty for none.
     pub title: String,
-    /// GIF frame size in pixels (width, height): side view on the left, top view on the right.
+    /// GIF frame size in pixels (width, height): side view on the left, top view on the
+    /// right (stacked instead when the clip travels far enough that this draws it larger).
     pub size: (u32, u32),
     /// Width of the strip PNG in pixels; its height follows from the layout.
     pub strip_width: u32,
@@ -36,8 +37,8 @@ impl Default for RenderOptions {
             title: String::new(),
             size: (640, 320),
             strip_width: 1280,
-            // 10 fps keeps a 10 s clip around a megabyte and still reads as smooth motion.
-            frame_step: 2,
+            // Every frame: with changed-rectangle encoding a 10 s clip is a few hundred kB.
+            frame_step: 1,
             frame_range: None,
             strip_frames: StripFrames::Count(8),
             camera_yaw_deg: None,

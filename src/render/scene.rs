@@ -22,10 +22,6 @@ pub(crate) struct Scene<'a> {
     pub fps: f32,
     /// Frames in the scene (the longest person; shorter ones hold their last pose).
     pub len: usize,
-    /// Lower corner of everything that must stay in view (floor included).
-    pub lo: Vec3,
-    /// Upper corner of everything that must stay in view.
-    pub hi: Vec3,
     /// Floor rectangle as (x, z) corners.
     pub floor_lo: Vec2,
     /// See `floor_lo`.
@@ -63,10 +59,8 @@ impl<'a> Scene<'a> {
         hi.y = hi.y.max(lo.y + 1.0);
         let floor_lo = Vec2::new(lo.x, lo.z) - FLOOR_MARGIN;
         let floor_hi = Vec2::new(hi.x, hi.z) + FLOOR_MARGIN;
-        lo = lo.min(Vec3::new(floor_lo.x, lo.y, floor_lo.y));
-        hi = hi.max(Vec3::new(floor_hi.x, hi.y, floor_hi.y));
         let prims = overlay_prims(&opts.overlays, floor_lo, floor_hi, lo.y, hi.y);
-        let mut scene = Scene { people, fps, len, lo, hi, floor_lo, floor_hi, prims, yaw: 0.0 };
+        let mut scene = Scene { people, fps, len, floor_lo, floor_hi, prims, yaw: 0.0 };
         scene.yaw = match opts.camera_yaw_deg {
             Some(d) if d.is_finite() => d.to_radians(),
             Some(d) => return Err(RenderError::BadOption(format!("camera yaw {d} is not finite"))),
@@ -89,6 +83,24 @@ impl<'a> Scene<'a> {
     /// Root (pelvis) positions of `person` over the whole clip.
     pub fn root_trail(&self, person: usize) -> Vec<Vec3> {
         self.people[person].joint_track(0)
+    }
+
+    /// What the side camera must keep in view: the floor rectangle, every joint of every
+    /// frame, and the overlays. Fitting these rather than the bounding box leaves no empty
+    /// corners above the far end of a long walk.
+    pub fn fit_points(&self) -> Vec<Vec3> {
+        let (l, h) = (self.floor_lo, self.floor_hi);
+        let mut pts = vec![
+            Vec3::new(l.x, 0.0, l.y),
+            Vec3::new(h.x, 0.0, l.y),
+            Vec3::new(h.x, 0.0, h.y),
+            Vec3::new(l.x, 0.0, h.y),
+        ];
+        for m in self.people {
+            pts.extend(m.frames.iter().flatten());
+        }
+        pts.extend(self.prims.iter().flat_map(|p| p.points()));
+        pts
     }
 
     /// Seconds at `frame`.

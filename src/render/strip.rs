@@ -49,7 +49,7 @@ impl Layout {
             (span(basis.right).max(1e-3), span(basis.up).max(1e-3))
         };
         let side = Basis::side(scene.yaw);
-        let (du, dv) = extent(side, &box_corners(scene.lo, scene.hi));
+        let (du, dv) = extent(side, &scene.fit_points());
         let cell_h = |c: usize| (wf / c as f32 - 2.0 * CELL_MARGIN) * dv / du + 2.0 * CELL_MARGIN + lh;
         let rows = |c: usize| k.div_ceil(c);
         let cols = (1..=k).find(|&c| rows(c) as f32 * cell_h(c) <= 1.5 * wf).unwrap_or(k);
@@ -94,7 +94,7 @@ fn paint(area: &Area, scene: &Scene, layout: &Layout, frames: &[usize], title: &
         let inner = Rect { y: cell.y + lh, h: cell.h - lh, ..cell };
         let view = side_view(scene, inner);
         draw_side(area, scene, &view, frame, small)?;
-        let caption = format!("#{}  {:.2} s  (frame {frame})", k + 1, scene.time(frame));
+        let caption = format!("#{}   {:.2} s   frame {frame}", k + 1, scene.time(frame));
         draw_caption(area, cell, &caption, small)?;
         outline(area, cell)?;
     }

@@ -81,7 +81,7 @@ fn dir_entries(dir: &Path) -> usize {
 fn gif_round_trip_has_every_frame_real_time_and_motion() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("walk.gif");
-    let opts = RenderOptions::titled("a person walks forward");
+    let opts = RenderOptions { frame_step: 2, ..RenderOptions::titled("a person walks forward") };
     render_gif(&[test_walk()], &opts, &path).unwrap();
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..6], b"GIF89a");
@@ -250,4 +250,45 @@ fn plot_lines_writes_a_png_and_rejects_bad_input() {
     assert!(plot_lines(&dir.path().join("loss.gif"), "t", "x", "y", &[train], &opts).is_err());
     assert!(!bad.exists());
     assert_eq!(dir_entries(dir.path()), 1);
+}
+
+/// Writes demo renders for looking at by eye (`cargo test --lib render::tests::demo --
+/// --ignored`): into `$MPROG_RENDER_DEMO` or `/tmp/mprog-render-demo`, GIF frames also as PNG.
+#[test]
+#[ignore = "writes pictures for manual inspection"]
+fn demo_renders_for_inspection() {
+    let dir = std::env::var("MPROG_RENDER_DEMO").unwrap_or_else(|_| "/tmp/mprog-render-demo".into());
+    let dir = Path::new(&dir);
+    let long_walk = walk(200, 1.2, Vec3::ZERO, Vec3::Z);
+    let rest = Motion::new(vec![rest_pose(); 20]);
+    let diagonal = walk(60, 1.0, Vec3::new(0.5, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.6));
+    let other = walk(60, 0.9, Vec3::new(2.0, 0.0, 3.0), Vec3::NEG_Z);
+    let mut opts = RenderOptions::titled("a person walks forward for ten seconds");
+    render_to_path(std::slice::from_ref(&long_walk), &opts, &dir.join("walk.gif")).unwrap();
+    render_to_path(&[long_walk], &opts, &dir.join("walk.png")).unwrap();
+    opts.title = "rest pose".into();
+    render_to_path(std::slice::from_ref(&rest), &opts, &dir.join("rest.gif")).unwrap();
+    render_to_path(&[rest], &opts, &dir.join("rest.png")).unwrap();
+    opts.title = "two people, a wall, a target and a box".into();
+    opts.overlays = vec![
+        Overlay::Point { at: Vec3::new(1.0, 1.2, 2.0), label: Some("target".into()) },
+        Overlay::VerticalPlane { point: Vec3::new(0.0, 0.0, 4.2), normal: Vec3::new(0.2, 0.0, 1.0) },
+        Overlay::Box { min: Vec3::new(-0.8, 0.0, 1.0), max: Vec3::new(-0.2, 0.6, 1.6) },
+        Overlay::HorizontalPlane { height: 1.9 },
+        Overlay::Segment { from: Vec3::new(0.5, 0.0, 0.0), to: Vec3::new(0.5, 1.0, 0.0) },
+    ];
+    let pair = [diagonal, other];
+    render_to_path(&pair, &opts, &dir.join("pair.gif")).unwrap();
+    render_to_path(&pair, &opts, &dir.join("pair.png")).unwrap();
+    for name in ["walk", "rest", "pair"] {
+        let g = decode_gif(&dir.join(format!("{name}.gif")));
+        for k in [0, g.frames.len() / 2, g.frames.len() - 1] {
+            let png = super::encode::encode_png(&g.frames[k], g.w as u32, g.h as u32).unwrap();
+            crate::fsutil::write_bytes_atomic(&dir.join(format!("{name}-gif-{k}.png")), &png).unwrap();
+        }
+    }
+    let loss = Series { name: "train".into(), points: (1..500).map(|i| (i as f32, 3.0 / (i as f32).sqrt() + 0.01)).collect() };
+    let val = Series { name: "val".into(), points: (1..25).map(|i| ((i * 20) as f32, 3.2 / ((i * 20) as f32).sqrt() + 0.02)).collect() };
+    plot_lines(&dir.join("loss-log.png"), "training loss", "step", "loss", &[loss.clone(), val.clone()], &PlotOptions { log_y: true, ..PlotOptions::default() }).unwrap();
+    plot_lines(&dir.join("loss-lin.png"), "training loss", "step", "loss", &[loss, val], &PlotOptions::default()).unwrap();
 }

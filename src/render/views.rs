@@ -28,7 +28,7 @@ pub(crate) fn label_height(size: f64) -> f32 {
 
 /// The side camera fitted to `rect` (below the panel's name line).
 pub(crate) fn side_view(scene: &Scene, rect: Rect) -> View {
-    View::fit(Basis::side(scene.yaw), &box_corners(scene.lo, scene.hi), rect, SIDE_MARGIN)
+    View::fit(Basis::side(scene.yaw), &scene.fit_points(), rect, SIDE_MARGIN)
 }
 
 /// The top camera fitted to `rect`; only the floor rectangle matters from above.
@@ -42,21 +42,21 @@ pub(crate) fn top_view(scene: &Scene, rect: Rect) -> View {
 fn axis_name(v: Vec3) -> &'static str {
     match (v.x.round() as i32, v.z.round() as i32) {
         (1, _) => "+x",
-        (-1, _) => "−x",
+        (-1, _) => "-x",
         (_, 1) => "+z",
-        _ => "−z",
+        _ => "-z",
     }
 }
 
 /// Panel caption for the top view, naming its axes.
 pub(crate) fn top_caption(view: &View) -> String {
-    format!("top  →{} ↑{}  grid 1 m", axis_name(view.basis.right), axis_name(view.basis.up))
+    format!("top view (right {}, up {}, grid 1 m)", axis_name(view.basis.right), axis_name(view.basis.up))
 }
 
 /// Side view of every person at `frame`.
 pub(crate) fn draw_side(area: &Area, scene: &Scene, view: &View, frame: usize, text_size: f64) -> Result<(), RenderError> {
     draw_floor(area, scene, view)?;
-    draw_overlay_lines(area, scene, view)?;
+    draw_overlay_lines(area, scene, view, false)?;
     draw_trails(area, scene, view, 1, 0.55)?;
     draw_shadows(area, scene, view, frame)?;
     draw_figures(area, scene, view, frame, false)?;
@@ -75,7 +75,7 @@ pub(crate) enum TopMarks<'f> {
 pub(crate) fn draw_top(area: &Area, scene: &Scene, view: &View, marks: TopMarks, text_size: f64) -> Result<(), RenderError> {
     draw_floor(area, scene, view)?;
     draw_metre_labels(area, scene, view, text_size * 0.85)?;
-    draw_overlay_lines(area, scene, view)?;
+    draw_overlay_lines(area, scene, view, true)?;
     draw_trails(area, scene, view, 2, 0.35)?;
     let arrow_px = (ARROW_M * view.scale).max(14.0);
     let facing_arrow = |person: usize, frame: usize| -> Result<(), RenderError> {
@@ -90,7 +90,7 @@ pub(crate) fn draw_top(area: &Area, scene: &Scene, view: &View, marks: TopMarks,
     };
     match marks {
         TopMarks::Current(frame) => {
-            draw_figures(area, scene, view, frame, view.scale < 80.0)?;
+            draw_figures(area, scene, view, frame, true)?;
             for person in 0..scene.people() {
                 facing_arrow(person, frame)?;
                 let root = scene.pose(person, frame)[0];
