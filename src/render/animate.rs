@@ -11,7 +11,9 @@ use super::frames::{gif_delays, gif_frames};
 use super::options::RenderOptions;
 use super::scene::Scene;
 use super::style::{GRID, TEXT};
-use super::views::{TopMarks, draw_caption, draw_side, draw_top, label_height, side_view, top_caption, top_view};
+use super::views::{
+    TopMarks, draw_caption, draw_side, draw_top, label_height, side_view, top_caption, top_view,
+};
 use crate::fsutil::write_bytes_atomic;
 use crate::motion::Motion;
 use rayon::prelude::*;
@@ -45,7 +47,9 @@ impl Layout {
     /// the views (side view on top, full width) draws the figures much larger.
     fn new(scene: &Scene, w: u32, h: u32) -> Result<Layout, RenderError> {
         if w < 160 || h < 100 {
-            return Err(RenderError::BadOption(format!("GIF size {w}x{h} is too small (min 160x100)")));
+            return Err(RenderError::BadOption(format!(
+                "GIF size {w}x{h} is too small (min 160x100)"
+            )));
         }
         let (wf, hf) = (w as f32, h as f32);
         let title_h = (hf * 0.075).clamp(16.0, 32.0).round();
@@ -53,20 +57,48 @@ impl Layout {
         let body = hf - title_h;
         let side_w = (wf * SIDE_SHARE).round();
         let beside = (
-            Rect { x: 0.0, y: title_h, w: side_w, h: body },
-            Rect { x: side_w, y: title_h, w: wf - side_w, h: body },
+            Rect {
+                x: 0.0,
+                y: title_h,
+                w: side_w,
+                h: body,
+            },
+            Rect {
+                x: side_w,
+                y: title_h,
+                w: wf - side_w,
+                h: body,
+            },
         );
         let side_h = (body * STACKED_SIDE_SHARE).round();
         let stacked = (
-            Rect { x: 0.0, y: title_h, w: wf, h: side_h },
-            Rect { x: 0.0, y: title_h + side_h, w: wf, h: body - side_h },
+            Rect {
+                x: 0.0,
+                y: title_h,
+                w: wf,
+                h: side_h,
+            },
+            Rect {
+                x: 0.0,
+                y: title_h + side_h,
+                w: wf,
+                h: body - side_h,
+            },
         );
         let inner = |r: Rect| {
             let lh = label_height(font * 0.8);
-            Rect { y: r.y + lh, h: r.h - lh, ..r }
+            Rect {
+                y: r.y + lh,
+                h: r.h - lh,
+                ..r
+            }
         };
         let scale = |r: Rect| side_view(scene, inner(r)).scale;
-        let (side, top) = if scale(stacked.0) > STACK_GAIN * scale(beside.0) { stacked } else { beside };
+        let (side, top) = if scale(stacked.0) > STACK_GAIN * scale(beside.0) {
+            stacked
+        } else {
+            beside
+        };
         Ok(Layout {
             w,
             h,
@@ -87,7 +119,10 @@ impl Layout {
 /// Nothing is written when an error is returned.
 pub fn render_gif(people: &[Motion], opts: &RenderOptions, path: &Path) -> Result<(), RenderError> {
     let bytes = gif_bytes(people, opts)?;
-    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io { path: path.to_path_buf(), source })
+    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// The GIF file's bytes.
@@ -98,11 +133,18 @@ pub(crate) fn gif_bytes(people: &[Motion], opts: &RenderOptions) -> Result<Vec<u
     let layout = Layout::new(&scene, opts.size.0, opts.size.1)?;
     ensure_fonts()?;
     let paint = |frame: usize| {
-        render_rgb(layout.w, layout.h, |area| paint_frame(area, &scene, &layout, frame, &opts.title))
+        render_rgb(layout.w, layout.h, |area| {
+            paint_frame(area, &scene, &layout, frame, &opts.title)
+        })
     };
     let n = PALETTE_SAMPLES.min(frames.len());
-    let samples: Vec<usize> = (0..n).map(|i| frames[i * (frames.len() - 1) / (n - 1).max(1)]).collect();
-    let sample_rgb = samples.par_iter().map(|&f| paint(f)).collect::<Result<Vec<_>, _>>()?;
+    let samples: Vec<usize> = (0..n)
+        .map(|i| frames[i * (frames.len() - 1) / (n - 1).max(1)])
+        .collect();
+    let sample_rgb = samples
+        .par_iter()
+        .map(|&f| paint(f))
+        .collect::<Result<Vec<_>, _>>()?;
     let palette = Palette::from_samples(&sample_rgb);
     drop(sample_rgb);
     let mut writer = GifWriter::new(layout.w, layout.h, &palette)?;
@@ -119,21 +161,52 @@ pub(crate) fn gif_bytes(people: &[Motion], opts: &RenderOptions) -> Result<Vec<u
 }
 
 /// One GIF frame.
-fn paint_frame(area: &Area, scene: &Scene, layout: &Layout, frame: usize, title: &str) -> Result<(), RenderError> {
+fn paint_frame(
+    area: &Area,
+    scene: &Scene,
+    layout: &Layout,
+    frame: usize,
+    title: &str,
+) -> Result<(), RenderError> {
     let font = layout.font;
     let last = scene.len - 1;
     let clock = format!("{:.2} s   frame {frame}/{last}", scene.time(frame));
     let clock_w = text_width(&clock, font);
     let y = ((layout.title_h as f64 - font) / 2.0).round() as i32;
-    text(area, &clock, (layout.w as i32 - 6, y), font, TEXT, TOP_RIGHT)?;
+    text(
+        area,
+        &clock,
+        (layout.w as i32 - 6, y),
+        font,
+        TEXT,
+        TOP_RIGHT,
+    )?;
     let room = f64::from(layout.w) - clock_w - 24.0;
-    text(area, &fit_text(title, font, room), (6, y), font, TEXT, TOP_LEFT)?;
+    text(
+        area,
+        &fit_text(title, font, room),
+        (6, y),
+        font,
+        TEXT,
+        TOP_LEFT,
+    )?;
 
     let small = font * 0.8;
     draw_side(area, scene, &layout.side_view, frame, small)?;
     draw_caption(area, layout.side, "side view", small)?;
-    draw_top(area, scene, &layout.top_view, TopMarks::Current(frame), small)?;
-    draw_caption(area, layout.top, &top_caption(&layout.top_view), small)?;
+    draw_top(
+        area,
+        scene,
+        &layout.top_view,
+        TopMarks::Current(frame),
+        small,
+    )?;
+    draw_caption(
+        area,
+        layout.top,
+        &top_caption(scene, &layout.top_view),
+        small,
+    )?;
 
     let (tx, ty) = (layout.top.x as i32, layout.top.y as i32);
     if tx > 0 {
@@ -141,7 +214,13 @@ fn paint_frame(area: &Area, scene: &Scene, layout: &Layout, frame: usize, title:
     } else {
         line(area, (0, ty), (layout.w as i32, ty), GRID, 1)?;
     }
-    line(area, (0, layout.title_h as i32 - 1), (layout.w as i32, layout.title_h as i32 - 1), GRID, 1)
+    line(
+        area,
+        (0, layout.title_h as i32 - 1),
+        (layout.w as i32, layout.title_h as i32 - 1),
+        GRID,
+        1,
+    )
 }
 
 #[cfg(test)]
@@ -161,7 +240,10 @@ mod tests {
         let stacked = Layout::new(&Scene::new(&long, &opts).unwrap(), 640, 320).unwrap();
         assert!(stacked.top.x == 0.0 && stacked.top.y > stacked.side.y);
         // Stacking must actually draw the walker larger than side by side would.
-        assert!(stacked.side_view.scale > STACK_GAIN * side_view(&Scene::new(&long, &opts).unwrap(), beside.side).scale);
+        assert!(
+            stacked.side_view.scale
+                > STACK_GAIN * side_view(&Scene::new(&long, &opts).unwrap(), beside.side).scale
+        );
         assert!(Layout::new(&Scene::new(&still, &opts).unwrap(), 100, 50).is_err());
     }
 }

@@ -62,10 +62,19 @@ pub(crate) fn draw_figures(
     draw_pieces(area, view, all, from_above)
 }
 
-fn draw_pieces(area: &Area, view: &View, mut all: Vec<Piece>, from_above: bool) -> Result<(), RenderError> {
+fn draw_pieces(
+    area: &Area,
+    view: &View,
+    mut all: Vec<Piece>,
+    from_above: bool,
+) -> Result<(), RenderError> {
     // Painter's algorithm: farthest first.
     all.sort_by(|a, b| b.depth(view).total_cmp(&a.depth(view)));
-    let width = if from_above && view.scale < 80.0 { 1 } else { bone_width(view.scale) };
+    let width = if from_above && view.scale < 80.0 {
+        1
+    } else {
+        bone_width(view.scale)
+    };
     let r = ((HEAD_RADIUS * view.scale).round() as i32).max(3);
     for piece in all {
         match piece {

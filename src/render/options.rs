@@ -19,7 +19,8 @@ pub struct RenderOptions {
     /// GIF: draw every `frame_step`-th frame (1 = every frame). The GIF still plays at the
     /// motion's real speed: each GIF frame lasts `frame_step / fps` seconds.
     pub frame_step: usize,
-    /// Restrict both outputs to these frames (`None`: the whole clip).
+    /// Restrict both outputs to these frames (`None`: the whole clip). Cameras, floor and
+    /// trails still cover the whole clip, so renders of different ranges line up.
     pub frame_range: Option<Range<usize>>,
     /// Which frames the strip shows.
     pub strip_frames: StripFrames,
@@ -50,16 +51,20 @@ impl Default for RenderOptions {
 impl RenderOptions {
     /// Default options with a caption.
     pub fn titled(title: impl Into<String>) -> Self {
-        RenderOptions { title: title.into(), ..Self::default() }
+        RenderOptions {
+            title: title.into(),
+            ..Self::default()
+        }
     }
 }
 
 /// Frames shown by the strip PNG.
 #[derive(Clone, Debug, PartialEq)]
 pub enum StripFrames {
-    /// This many evenly spaced frames, first and last included (fewer if the clip is shorter).
+    /// This many evenly spaced frames, first and last included (fewer if the clip is
+    /// shorter); at most 64.
     Count(usize),
-    /// Exactly these frame indices, in this order.
+    /// Exactly these frame indices, in this order; at most 64.
     Indices(Vec<usize>),
 }
 

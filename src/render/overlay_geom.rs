@@ -46,13 +46,23 @@ pub(crate) fn overlay_prims(
                 let base = Vec2::new(point.x, point.z);
                 if let Some((a, b)) = clip_line(base, along, floor_lo, floor_hi) {
                     let at = |p: Vec2, y: f32| Vec3::new(p.x, y, p.y);
-                    out.push(Prim::Quad([at(a, y_lo), at(b, y_lo), at(b, y_hi), at(a, y_hi)]));
+                    out.push(Prim::Quad([
+                        at(a, y_lo),
+                        at(b, y_lo),
+                        at(b, y_hi),
+                        at(a, y_hi),
+                    ]));
                 }
             }
             Overlay::HorizontalPlane { height } => {
                 let at = |x: f32, z: f32| Vec3::new(x, *height, z);
                 let (l, h) = (floor_lo, floor_hi);
-                out.push(Prim::Quad([at(l.x, l.y), at(h.x, l.y), at(h.x, h.y), at(l.x, h.y)]));
+                out.push(Prim::Quad([
+                    at(l.x, l.y),
+                    at(h.x, l.y),
+                    at(h.x, h.y),
+                    at(l.x, h.y),
+                ]));
             }
             Overlay::Box { min, max } => {
                 let corner = |i: usize| {
@@ -99,29 +109,47 @@ mod tests {
 
     #[test]
     fn wall_is_clipped_to_the_floor_rectangle() {
-        let wall = Overlay::VerticalPlane { point: Vec3::new(0.0, 0.0, 2.0), normal: Vec3::Z };
+        let wall = Overlay::VerticalPlane {
+            point: Vec3::new(0.0, 0.0, 2.0),
+            normal: Vec3::Z,
+        };
         let prims = overlay_prims(&[wall], Vec2::new(-1.0, 0.0), Vec2::new(3.0, 5.0), 0.0, 2.0);
         assert_eq!(prims.len(), 1);
         // The bottom edge runs along x at z = 2 across the whole floor width.
-        let Prim::Quad([a, b, c, _]) = &prims[0] else { panic!("expected a quad") };
+        let Prim::Quad([a, b, c, _]) = &prims[0] else {
+            panic!("expected a quad")
+        };
         assert_eq!(c.y, 2.0);
         let (xa, xb) = (a.x.min(b.x), a.x.max(b.x));
-        assert!((xa + 1.0).abs() < 1e-5 && (xb - 3.0).abs() < 1e-5, "{a} {b}");
+        assert!(
+            (xa + 1.0).abs() < 1e-5 && (xb - 3.0).abs() < 1e-5,
+            "{a} {b}"
+        );
         assert!((a.z - 2.0).abs() < 1e-5 && (b.z - 2.0).abs() < 1e-5);
         assert_eq!((a.y, b.y), (0.0, 0.0));
     }
 
     #[test]
     fn diagonal_wall_and_box_edges() {
-        let d = clip_line(Vec2::ZERO, Vec2::new(1.0, 1.0).normalize(), Vec2::splat(-1.0), Vec2::new(2.0, 0.5));
+        let d = clip_line(
+            Vec2::ZERO,
+            Vec2::new(1.0, 1.0).normalize(),
+            Vec2::splat(-1.0),
+            Vec2::new(2.0, 0.5),
+        );
         let (a, b) = d.unwrap();
         assert!((a - Vec2::splat(-1.0)).length() < 1e-5 && (b - Vec2::splat(0.5)).length() < 1e-5);
         assert!(clip_line(Vec2::new(5.0, 0.0), Vec2::Y, Vec2::ZERO, Vec2::ONE).is_none());
-        let bx = Overlay::Box { min: Vec3::ZERO, max: Vec3::ONE };
+        let bx = Overlay::Box {
+            min: Vec3::ZERO,
+            max: Vec3::ONE,
+        };
         let prims = overlay_prims(&[bx], Vec2::ZERO, Vec2::ONE, 0.0, 1.0);
         assert_eq!(prims.len(), 12);
         for p in prims {
-            let Prim::Line(a, b) = p else { panic!("expected a line") };
+            let Prim::Line(a, b) = p else {
+                panic!("expected a line")
+            };
             assert!(((a - b).length() - 1.0).abs() < 1e-6);
         }
     }

@@ -34,7 +34,10 @@ pub struct PlotOptions {
 
 impl Default for PlotOptions {
     fn default() -> Self {
-        PlotOptions { size: (800, 480), log_y: false }
+        PlotOptions {
+            size: (800, 480),
+            log_y: false,
+        }
     }
 }
 
@@ -67,12 +70,18 @@ pub fn plot_lines(
     series: &[Series],
     opts: &PlotOptions,
 ) -> Result<(), RenderError> {
-    let is_png = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let is_png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if !is_png {
         return Err(RenderError::UnknownFormat(path.to_path_buf()));
     }
     let bytes = plot_png(title, x_label, y_label, series, opts)?;
-    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io { path: path.to_path_buf(), source })
+    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// The plot's PNG bytes.
@@ -85,28 +94,47 @@ pub(crate) fn plot_png(
 ) -> Result<Vec<u8>, RenderError> {
     let (w, h) = opts.size;
     if w < 200 || h < 150 {
-        return Err(RenderError::BadOption(format!("plot size {w}x{h} is too small (min 200x150)")));
+        return Err(RenderError::BadOption(format!(
+            "plot size {w}x{h} is too small (min 200x150)"
+        )));
     }
     let kept: Vec<Vec<(f32, f32)>> = series
         .iter()
         .map(|s| {
-            let keep = |&&(x, y): &&(f32, f32)| x.is_finite() && y.is_finite() && (!opts.log_y || y > 0.0);
+            let keep =
+                |&&(x, y): &&(f32, f32)| x.is_finite() && y.is_finite() && (!opts.log_y || y > 0.0);
             s.points.iter().filter(keep).copied().collect()
         })
         .collect();
     let all: Vec<(f32, f32)> = kept.iter().flatten().copied().collect();
     if all.is_empty() {
-        let why = if opts.log_y { "no finite positive points for a log-scale plot" } else { "no finite points" };
+        let why = if opts.log_y {
+            "no finite positive points for a log-scale plot"
+        } else {
+            "no finite points"
+        };
         return Err(RenderError::BadPlot(why.into()));
     }
     let xr = padded(all.iter().map(|p| p.0), false);
     let yr = padded(all.iter().map(|p| p.1), opts.log_y);
     ensure_fonts()?;
-    let labels = Labels { title, x: x_label, y: y_label };
+    let labels = Labels {
+        title,
+        x: x_label,
+        y: y_label,
+    };
     let rgb = render_rgb(w, h, |area| {
         area.fill(&WHITE).map_err(draw_err)?;
         if opts.log_y {
-            chart(area, &labels, xr, yr.clone().log_scale(), Some(yr), series, &kept)
+            chart(
+                area,
+                &labels,
+                xr,
+                yr.clone().log_scale(),
+                Some(yr),
+                series,
+                &kept,
+            )
         } else {
             chart(area, &labels, xr, yr, None, series, &kept)
         }
@@ -156,7 +184,11 @@ fn tick(v: f32) -> String {
 /// narrow even for that gets five geometrically spaced ticks.
 fn log_ticks(lo: f32, hi: f32) -> Vec<f32> {
     let (e0, e1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
-    let steps: [&[f32]; 3] = [&[1.0], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]];
+    let steps: [&[f32]; 3] = [
+        &[1.0],
+        &[1.0, 2.0, 5.0],
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+    ];
     for mults in steps {
         let ticks: Vec<f32> = (e0..=e1)
             .flat_map(|e| mults.iter().map(move |m| m * 10f32.powi(e)))
@@ -168,7 +200,9 @@ fn log_ticks(lo: f32, hi: f32) -> Vec<f32> {
             return ticks.into_iter().step_by(keep_every).collect();
         }
     }
-    (0..5).map(|i| lo * (hi / lo).powf(i as f32 / 4.0)).collect()
+    (0..5)
+        .map(|i| lo * (hi / lo).powf(i as f32 / 4.0))
+        .collect()
 }
 
 fn chart<'a, Y>(
@@ -216,7 +250,14 @@ where
             let (x, y) = chart.backend_coord(&(x0, v));
             line(area, (x + 1, y), (right - 1, y), RGBColor(215, 215, 215), 1)?;
             line(area, (x - 5, y), (x, y), RGBColor(0, 0, 0), 1)?;
-            text(area, &tick(v), (x - 8, y), 12.0, RGBColor(0, 0, 0), (HPos::Right, VPos::Center))?;
+            text(
+                area,
+                &tick(v),
+                (x - 8, y),
+                12.0,
+                RGBColor(0, 0, 0),
+                (HPos::Right, VPos::Center),
+            )?;
         }
     }
     for (i, (s, pts)) in series.iter().zip(kept).enumerate() {
@@ -261,10 +302,15 @@ mod tests {
         assert_eq!(tick(3.0), "3");
         assert_eq!(tick(0.0), "0");
         assert_eq!(tick(1.5e-5), "1.5e-5");
-        let close = |a: &[f32], b: &[f32]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x / y - 1.0).abs() < 1e-5);
+        let close = |a: &[f32], b: &[f32]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x / y - 1.0).abs() < 1e-5)
+        };
         assert!(close(&log_ticks(1e-4, 2.0), &[1e-4, 1e-3, 1e-2, 1e-1, 1.0]));
         assert!(close(&log_ticks(0.13, 3.2), &[0.2, 0.5, 1.0, 2.0]));
-        assert!(close(&log_ticks(0.13, 0.9), &[0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]));
+        assert!(close(
+            &log_ticks(0.13, 0.9),
+            &[0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]
+        ));
         assert!(log_ticks(1e-20, 1e20).len() <= 12);
         let narrow = log_ticks(0.55, 0.6);
         assert_eq!(narrow.len(), 5);
