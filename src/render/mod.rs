@@ -52,6 +52,8 @@ mod views;
 #[cfg(test)]
 mod test_motion;
 #[cfg(test)]
+mod test_util;
+#[cfg(test)]
 mod tests;
 
 pub use animate::render_gif;

@@ -290,6 +290,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::test_util::{decode_png, dir_entries, pixels_of};
 
     #[test]
     fn ranges_and_ticks() {
@@ -315,5 +316,51 @@ mod tests {
         let narrow = log_ticks(0.55, 0.6);
         assert_eq!(narrow.len(), 5);
         assert!((narrow[0] - 0.55).abs() < 1e-6 && (narrow[4] - 0.6).abs() < 1e-5);
+    }
+
+    #[test]
+    fn plot_lines_writes_a_png_and_rejects_bad_input() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("loss.png");
+        let train = Series {
+            name: "train".into(),
+            points: (1..200).map(|i| (i as f32, 5.0 / i as f32)).collect(),
+        };
+        let mut val_pts: Vec<(f32, f32)> = (1..20)
+            .map(|i| ((i * 10) as f32, 6.0 / (i * 10) as f32))
+            .collect();
+        val_pts.push((200.0, f32::NAN));
+        let val = Series {
+            name: "val".into(),
+            points: val_pts,
+        };
+        let opts = PlotOptions {
+            log_y: true,
+            ..PlotOptions::default()
+        };
+        plot_lines(&path, "loss", "step", "loss", &[train.clone(), val], &opts).unwrap();
+        let (w, h, rgb) = decode_png(&path);
+        assert_eq!((w, h), (800, 480));
+        // Both series are drawn in their colours.
+        assert!(pixels_of(&rgb, w, RGBColor(31, 119, 180)).len() > 200);
+        assert!(pixels_of(&rgb, w, RGBColor(255, 127, 14)).len() > 50);
+
+        let nan_only = Series {
+            name: "nan".into(),
+            points: vec![(0.0, f32::NAN)],
+        };
+        let bad = dir.path().join("bad.png");
+        assert!(matches!(
+            plot_lines(&bad, "t", "x", "y", &[nan_only], &PlotOptions::default()),
+            Err(RenderError::BadPlot(_))
+        ));
+        let negative = Series {
+            name: "neg".into(),
+            points: vec![(0.0, -1.0), (1.0, 0.0)],
+        };
+        assert!(plot_lines(&bad, "t", "x", "y", &[negative], &opts).is_err());
+        assert!(plot_lines(&dir.path().join("loss.gif"), "t", "x", "y", &[train], &opts).is_err());
+        assert!(!bad.exists());
+        assert_eq!(dir_entries(dir.path()), 1);
     }
 }

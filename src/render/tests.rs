@@ -8,83 +8,13 @@ use super::draw::render_rgb;
 use super::scene::Scene;
 use super::style::{OVERLAY, person_colors};
 use super::test_motion::{test_walk, walk};
+use super::test_util::{decode_gif, decode_png, dir_entries, mean, pixels_of};
 use super::views::{TopMarks, draw_side, draw_top, side_view, top_view};
 use super::*;
 use crate::motion::Motion;
 use crate::skeleton::rest_pose;
 use glam::Vec3;
-use plotters::style::RGBColor;
 use std::path::Path;
-
-/// A decoded GIF: size, per-frame delays and the composited RGB picture after each frame.
-struct DecodedGif {
-    w: usize,
-    h: usize,
-    delays: Vec<u16>,
-    frames: Vec<Vec<u8>>,
-}
-
-fn decode_gif(path: &Path) -> DecodedGif {
-    let mut opts = gif::DecodeOptions::new();
-    opts.set_color_output(gif::ColorOutput::Indexed);
-    let mut dec = opts.read_info(std::fs::File::open(path).unwrap()).unwrap();
-    let (w, h) = (usize::from(dec.width()), usize::from(dec.height()));
-    let palette = dec.global_palette().unwrap().to_vec();
-    let mut canvas = vec![0u8; w * h * 3];
-    let (mut delays, mut frames) = (Vec::new(), Vec::new());
-    while let Some(f) = dec.read_next_frame().unwrap() {
-        for y in 0..usize::from(f.height) {
-            for x in 0..usize::from(f.width) {
-                let i = f.buffer[y * usize::from(f.width) + x];
-                if Some(i) == f.transparent {
-                    continue;
-                }
-                let at = ((y + usize::from(f.top)) * w + x + usize::from(f.left)) * 3;
-                canvas[at..at + 3]
-                    .copy_from_slice(&palette[usize::from(i) * 3..usize::from(i) * 3 + 3]);
-            }
-        }
-        delays.push(f.delay);
-        frames.push(canvas.clone());
-    }
-    DecodedGif {
-        w,
-        h,
-        delays,
-        frames,
-    }
-}
-
-fn decode_png(path: &Path) -> (usize, usize, Vec<u8>) {
-    let dec = png::Decoder::new(std::fs::File::open(path).unwrap());
-    let mut reader = dec.read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, png::ColorType::Rgb);
-    buf.truncate(info.buffer_size());
-    (info.width as usize, info.height as usize, buf)
-}
-
-/// Pixel positions (x, y) of an exact colour in a packed RGB picture of width `w`.
-fn pixels_of(rgb: &[u8], w: usize, c: RGBColor) -> Vec<(usize, usize)> {
-    rgb.chunks_exact(3)
-        .enumerate()
-        .filter(|(_, p)| p[0] == c.0 && p[1] == c.1 && p[2] == c.2)
-        .map(|(i, _)| (i % w, i / w))
-        .collect()
-}
-
-fn mean(v: &[(usize, usize)]) -> (f32, f32) {
-    let n = v.len().max(1) as f32;
-    (
-        v.iter().map(|p| p.0 as f32).sum::<f32>() / n,
-        v.iter().map(|p| p.1 as f32).sum::<f32>() / n,
-    )
-}
-
-fn dir_entries(dir: &Path) -> usize {
-    std::fs::read_dir(dir).unwrap().count()
-}
 
 #[test]
 fn gif_round_trip_has_every_frame_real_time_and_motion() {
@@ -332,52 +262,6 @@ fn bad_motions_are_errors_and_write_nothing() {
         );
     }
     assert_eq!(dir_entries(dir.path()), 0, "an error left a file behind");
-}
-
-#[test]
-fn plot_lines_writes_a_png_and_rejects_bad_input() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("loss.png");
-    let train = Series {
-        name: "train".into(),
-        points: (1..200).map(|i| (i as f32, 5.0 / i as f32)).collect(),
-    };
-    let mut val_pts: Vec<(f32, f32)> = (1..20)
-        .map(|i| ((i * 10) as f32, 6.0 / (i * 10) as f32))
-        .collect();
-    val_pts.push((200.0, f32::NAN));
-    let val = Series {
-        name: "val".into(),
-        points: val_pts,
-    };
-    let opts = PlotOptions {
-        log_y: true,
-        ..PlotOptions::default()
-    };
-    plot_lines(&path, "loss", "step", "loss", &[train.clone(), val], &opts).unwrap();
-    let (w, h, rgb) = decode_png(&path);
-    assert_eq!((w, h), (800, 480));
-    // Both series are drawn in their colours.
-    assert!(pixels_of(&rgb, w, RGBColor(31, 119, 180)).len() > 200);
-    assert!(pixels_of(&rgb, w, RGBColor(255, 127, 14)).len() > 50);
-
-    let nan_only = Series {
-        name: "nan".into(),
-        points: vec![(0.0, f32::NAN)],
-    };
-    let bad = dir.path().join("bad.png");
-    assert!(matches!(
-        plot_lines(&bad, "t", "x", "y", &[nan_only], &PlotOptions::default()),
-        Err(RenderError::BadPlot(_))
-    ));
-    let negative = Series {
-        name: "neg".into(),
-        points: vec![(0.0, -1.0), (1.0, 0.0)],
-    };
-    assert!(plot_lines(&bad, "t", "x", "y", &[negative], &opts).is_err());
-    assert!(plot_lines(&dir.path().join("loss.gif"), "t", "x", "y", &[train], &opts).is_err());
-    assert!(!bad.exists());
-    assert_eq!(dir_entries(dir.path()), 1);
 }
 
 /// Writes demo renders for looking at by eye (`cargo test --lib render::tests::demo --
