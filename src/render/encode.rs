@@ -236,4 +236,40 @@ mod tests {
             (1, 1, &[255u8][..])
         );
     }
+
+    #[test]
+    fn gif_frames_decode_back_to_the_pictures_pushed() {
+        // Three colours; frames change a moving block, then one frame repeats exactly.
+        let (w, h) = (12usize, 7usize);
+        let colours = [[255u8, 255, 255], [20, 70, 170], [210, 0, 150]];
+        let picture = |k: usize| -> Vec<u8> {
+            (0..w * h)
+                .flat_map(|i| {
+                    let (x, y) = (i % w, i / w);
+                    let c = if x / 3 == k % 4 && y > 1 {
+                        1
+                    } else if x == 11 - k {
+                        2
+                    } else {
+                        0
+                    };
+                    colours[c]
+                })
+                .collect()
+        };
+        let frames: Vec<Vec<u8>> = [0, 1, 2, 2, 3].into_iter().map(picture).collect();
+        let palette = Palette::from_samples(&frames);
+        let mut writer = GifWriter::new(w as u32, h as u32, &palette).unwrap();
+        for f in &frames {
+            writer.push(palette.quantise(f), 5).unwrap();
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.gif");
+        std::fs::write(&path, writer.finish().unwrap()).unwrap();
+        let g = crate::render::test_util::decode_gif(&path);
+        assert_eq!((g.w, g.h, g.delays.len()), (w, h, 5));
+        for (k, f) in frames.iter().enumerate() {
+            assert_eq!(&g.frames[k], f, "frame {k} differs after decoding");
+        }
+    }
 }
