@@ -56,7 +56,11 @@ impl Basis {
             .max_by(|a, b| a.dot(side.right).total_cmp(&b.dot(side.right)))
             .unwrap_or(Vec3::Z);
         let forward = Vec3::NEG_Y;
-        Basis { right, up: right.cross(forward), forward }
+        Basis {
+            right,
+            up: right.cross(forward),
+            forward,
+        }
     }
 }
 
@@ -96,7 +100,10 @@ impl View {
 
     /// Pixel position of a world point (sub-pixel).
     pub fn pxf(&self, p: Vec3) -> (f32, f32) {
-        (self.ox + self.scale * p.dot(self.basis.right), self.oy - self.scale * p.dot(self.basis.up))
+        (
+            self.ox + self.scale * p.dot(self.basis.right),
+            self.oy - self.scale * p.dot(self.basis.up),
+        )
     }
 
     /// Pixel position of a world point.
@@ -127,13 +134,23 @@ mod tests {
     use super::*;
 
     fn rect() -> Rect {
-        Rect { x: 10.0, y: 20.0, w: 200.0, h: 100.0 }
+        Rect {
+            x: 10.0,
+            y: 20.0,
+            w: 200.0,
+            h: 100.0,
+        }
     }
 
     #[test]
     fn side_view_is_upright_and_walks_right() {
         let b = Basis::side(0.0);
-        let v = View::fit(b, &box_corners(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 2.0, 4.0)), rect(), 5.0);
+        let v = View::fit(
+            b,
+            &box_corners(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 2.0, 4.0)),
+            rect(),
+            5.0,
+        );
         // Up is up on screen (smaller pixel y) and +Z goes right.
         assert!(v.pxf(Vec3::Y).1 < v.pxf(Vec3::ZERO).1);
         assert!(v.pxf(Vec3::Z).0 > v.pxf(Vec3::ZERO).0);
@@ -165,7 +182,10 @@ mod tests {
             let v = View::fit(b, &pts, rect(), 5.0);
             for p in pts {
                 let (x, y) = v.pxf(p);
-                assert!((14.9..=205.1).contains(&x) && (24.9..=115.1).contains(&y), "{x} {y}");
+                assert!(
+                    (14.9..=205.1).contains(&x) && (24.9..=115.1).contains(&y),
+                    "{x} {y}"
+                );
             }
         }
     }

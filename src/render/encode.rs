@@ -48,15 +48,27 @@ impl Palette {
         if colors.is_empty() {
             colors.push([255, 255, 255]);
         }
-        let exact = colors.iter().enumerate().map(|(i, c)| (*c, i as u8)).collect();
+        let exact = colors
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (*c, i as u8))
+            .collect();
         let nearest = (0..32 * 32 * 32)
             .map(|key: usize| {
-                let c = [(key >> 10) & 31, (key >> 5) & 31, key & 31].map(|v| (v * 255 / 31) as i32);
-                let dist = |p: &[u8; 3]| (0..3).map(|k| (i32::from(p[k]) - c[k]).pow(2)).sum::<i32>();
-                (0..colors.len()).min_by_key(|&i| dist(&colors[i])).unwrap_or(0) as u8
+                let c =
+                    [(key >> 10) & 31, (key >> 5) & 31, key & 31].map(|v| (v * 255 / 31) as i32);
+                let dist =
+                    |p: &[u8; 3]| (0..3).map(|k| (i32::from(p[k]) - c[k]).pow(2)).sum::<i32>();
+                (0..colors.len())
+                    .min_by_key(|&i| dist(&colors[i]))
+                    .unwrap_or(0) as u8
             })
             .collect();
-        Palette { colors, exact, nearest }
+        Palette {
+            colors,
+            exact,
+            nearest,
+        }
     }
 
     /// Palette index of one colour.
@@ -64,7 +76,9 @@ impl Palette {
         match self.exact.get(&c) {
             Some(i) => *i,
             None => {
-                let key = (usize::from(c[0] >> 3) << 10) | (usize::from(c[1] >> 3) << 5) | usize::from(c[2] >> 3);
+                let key = (usize::from(c[0] >> 3) << 10)
+                    | (usize::from(c[1] >> 3) << 5)
+                    | usize::from(c[2] >> 3);
                 self.nearest[key]
             }
         }
@@ -109,17 +123,30 @@ impl GifWriter {
     /// A looping GIF of `w`×`h` pixels with `palette` as its global colour table.
     pub fn new(w: u32, h: u32, palette: &Palette) -> Result<GifWriter, RenderError> {
         let too_big = || RenderError::BadOption(format!("GIF size {w}x{h} exceeds 65535"));
-        let (w, h) = (u16::try_from(w).map_err(|_| too_big())?, u16::try_from(h).map_err(|_| too_big())?);
+        let (w, h) = (
+            u16::try_from(w).map_err(|_| too_big())?,
+            u16::try_from(h).map_err(|_| too_big())?,
+        );
         let mut enc = gif::Encoder::new(Vec::new(), w, h, &palette.table()).map_err(gif_err)?;
         enc.set_repeat(gif::Repeat::Infinite).map_err(gif_err)?;
-        Ok(GifWriter { enc, w, h, prev: None })
+        Ok(GifWriter {
+            enc,
+            w,
+            h,
+            prev: None,
+        })
     }
 
     /// Appends a frame of palette indices shown for `delay_cs` hundredths of a second.
     pub fn push(&mut self, indices: Vec<u8>, delay_cs: u16) -> Result<(), RenderError> {
         let (w, h) = (usize::from(self.w), usize::from(self.h));
         let mut frame = match &self.prev {
-            None => gif::Frame { width: self.w, height: self.h, buffer: indices.as_slice().into(), ..Default::default() },
+            None => gif::Frame {
+                width: self.w,
+                height: self.h,
+                buffer: indices.as_slice().into(),
+                ..Default::default()
+            },
             Some(prev) => changed_part(prev, &indices, w, h),
         };
         frame.delay = delay_cs;
@@ -154,7 +181,11 @@ fn changed_part(prev: &[u8], cur: &[u8], w: usize, h: usize) -> gif::Frame<'stat
     for y in y0..=y1 {
         for x in x0..=x1 {
             let i = y * w + x;
-            buffer.push(if prev[i] == cur[i] { TRANSPARENT } else { cur[i] });
+            buffer.push(if prev[i] == cur[i] {
+                TRANSPARENT
+            } else {
+                cur[i]
+            });
         }
     }
     gif::Frame {
@@ -184,7 +215,10 @@ mod tests {
         assert_eq!(p.colors[usize::from(q[0])], [255, 255, 255]);
         assert_eq!(p.colors[usize::from(q[100])], [20, 70, 170]);
         // An unseen near-white maps to white.
-        assert_eq!(p.colors[usize::from(p.quantise(&[250, 252, 251])[0])], [255, 255, 255]);
+        assert_eq!(
+            p.colors[usize::from(p.quantise(&[250, 252, 251])[0])],
+            [255, 255, 255]
+        );
     }
 
     #[test]
@@ -197,6 +231,45 @@ mod tests {
         assert_eq!((f.left, f.top, f.width, f.height), (1, 1, 3, 2));
         assert_eq!(&f.buffer[..], &[7, 255, 255, 255, 255, 9]);
         let same = changed_part(&prev, &prev, 5, 4);
-        assert_eq!((same.width, same.height, &same.buffer[..]), (1, 1, &[255u8][..]));
+        assert_eq!(
+            (same.width, same.height, &same.buffer[..]),
+            (1, 1, &[255u8][..])
+        );
+    }
+
+    #[test]
+    fn gif_frames_decode_back_to_the_pictures_pushed() {
+        // Three colours; frames change a moving block, then one frame repeats exactly.
+        let (w, h) = (12usize, 7usize);
+        let colours = [[255u8, 255, 255], [20, 70, 170], [210, 0, 150]];
+        let picture = |k: usize| -> Vec<u8> {
+            (0..w * h)
+                .flat_map(|i| {
+                    let (x, y) = (i % w, i / w);
+                    let c = if x / 3 == k % 4 && y > 1 {
+                        1
+                    } else if x == 11 - k {
+                        2
+                    } else {
+                        0
+                    };
+                    colours[c]
+                })
+                .collect()
+        };
+        let frames: Vec<Vec<u8>> = [0, 1, 2, 2, 3].into_iter().map(picture).collect();
+        let palette = Palette::from_samples(&frames);
+        let mut writer = GifWriter::new(w as u32, h as u32, &palette).unwrap();
+        for f in &frames {
+            writer.push(palette.quantise(f), 5).unwrap();
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.gif");
+        std::fs::write(&path, writer.finish().unwrap()).unwrap();
+        let g = crate::render::test_util::decode_gif(&path);
+        assert_eq!((g.w, g.h, g.delays.len()), (w, h, 5));
+        for (k, f) in frames.iter().enumerate() {
+            assert_eq!(&g.frames[k], f, "frame {k} differs after decoding");
+        }
     }
 }

@@ -3,7 +3,7 @@
 //! all people's pieces painted farthest first so nearer limbs cover farther ones.
 
 use super::camera::View;
-use super::draw::{Area, disc, line};
+use super::draw::{Area, disc, line, ring};
 use super::error::RenderError;
 use super::scene::Scene;
 use super::style::{PersonColors, bone_width, chain_side, person_colors};
@@ -46,32 +46,41 @@ fn pieces(pose: &Pose, colors: &PersonColors, out: &mut Vec<Piece>) {
     out.push(Piece::Head(pose[HEAD] + up * HEAD_LIFT, colors.centre));
 }
 
-/// Draws all people at `frame`; `thin` draws hairlines (small top-view figures).
+/// Draws all people at `frame`. `from_above` (top view) outlines the head so it does not
+/// hide the shoulders, and uses hairlines when the map is small.
 pub(crate) fn draw_figures(
     area: &Area,
     scene: &Scene,
     view: &View,
     frame: usize,
-    thin: bool,
+    from_above: bool,
 ) -> Result<(), RenderError> {
     let mut all = Vec::new();
     for person in 0..scene.people() {
         pieces(scene.pose(person, frame), &person_colors(person), &mut all);
     }
-    draw_pieces(area, view, all, thin)
+    draw_pieces(area, view, all, from_above)
 }
 
-fn draw_pieces(area: &Area, view: &View, mut all: Vec<Piece>, thin: bool) -> Result<(), RenderError> {
+fn draw_pieces(
+    area: &Area,
+    view: &View,
+    mut all: Vec<Piece>,
+    from_above: bool,
+) -> Result<(), RenderError> {
     // Painter's algorithm: farthest first.
     all.sort_by(|a, b| b.depth(view).total_cmp(&a.depth(view)));
-    let width = if thin { 1 } else { bone_width(view.scale) };
+    let width = if from_above && view.scale < 80.0 {
+        1
+    } else {
+        bone_width(view.scale)
+    };
+    let r = ((HEAD_RADIUS * view.scale).round() as i32).max(3);
     for piece in all {
         match piece {
             Piece::Bone(a, b, color) => line(area, view.px(a), view.px(b), color, width)?,
-            Piece::Head(c, color) => {
-                let r = (HEAD_RADIUS * view.scale).round() as i32;
-                disc(area, view.px(c), r.max(if thin { 1 } else { 3 }), color)?;
-            }
+            Piece::Head(c, color) if from_above => ring(area, view.px(c), r, color, width.min(2))?,
+            Piece::Head(c, color) => disc(area, view.px(c), r, color)?,
         }
     }
     Ok(())

@@ -9,10 +9,14 @@ use std::ops::Range;
 pub(crate) fn clip_range(len: usize, opts: &RenderOptions) -> Result<Range<usize>, RenderError> {
     match &opts.frame_range {
         None => Ok(0..len),
-        Some(r) if r.start >= r.end => {
-            Err(RenderError::BadOption(format!("frame range {}..{} is empty", r.start, r.end)))
-        }
-        Some(r) if r.end > len => Err(RenderError::FrameOutOfRange { frame: r.end - 1, len }),
+        Some(r) if r.start >= r.end => Err(RenderError::BadOption(format!(
+            "frame range {}..{} is empty",
+            r.start, r.end
+        ))),
+        Some(r) if r.end > len => Err(RenderError::FrameOutOfRange {
+            frame: r.end - 1,
+            len,
+        }),
         Some(r) => Ok(r.clone()),
     }
 }
@@ -20,7 +24,9 @@ pub(crate) fn clip_range(len: usize, opts: &RenderOptions) -> Result<Range<usize
 /// GIF frames: every `frame_step`-th frame of the range.
 pub(crate) fn gif_frames(len: usize, opts: &RenderOptions) -> Result<Vec<usize>, RenderError> {
     if opts.frame_step == 0 {
-        return Err(RenderError::BadOption("frame_step must be at least 1".into()));
+        return Err(RenderError::BadOption(
+            "frame_step must be at least 1".into(),
+        ));
     }
     Ok(clip_range(len, opts)?.step_by(opts.frame_step).collect())
 }
@@ -44,11 +50,18 @@ pub(crate) fn gif_delays(frames: &[usize], fps: f32, step: usize) -> Result<Vec<
     Ok(delays)
 }
 
+/// Most cells a strip draws (more would shrink each figure to a few pixels).
+pub(crate) const MAX_STRIP_FRAMES: usize = 64;
+
 /// Strip frames: the explicit list, or `count` evenly spaced frames of the range with the
 /// first and last included.
 pub(crate) fn strip_frames(len: usize, opts: &RenderOptions) -> Result<Vec<usize>, RenderError> {
     let range = clip_range(len, opts)?;
+    let too_many =
+        |n: usize| RenderError::BadOption(format!("{n} strip frames; at most {MAX_STRIP_FRAMES}"));
     match &opts.strip_frames {
+        StripFrames::Indices(list) if list.len() > MAX_STRIP_FRAMES => Err(too_many(list.len())),
+        StripFrames::Count(k) if *k > MAX_STRIP_FRAMES => Err(too_many(*k)),
         StripFrames::Indices(list) => {
             if list.is_empty() {
                 return Err(RenderError::BadOption("strip frame list is empty".into()));
@@ -58,14 +71,18 @@ pub(crate) fn strip_frames(len: usize, opts: &RenderOptions) -> Result<Vec<usize
                 None => Ok(list.clone()),
             }
         }
-        StripFrames::Count(0) => Err(RenderError::BadOption("strip needs at least 1 frame".into())),
+        StripFrames::Count(0) => Err(RenderError::BadOption(
+            "strip needs at least 1 frame".into(),
+        )),
         StripFrames::Count(k) => {
             let n = range.len();
             let k = (*k).min(n);
             if k == 1 {
                 return Ok(vec![range.start]);
             }
-            Ok((0..k).map(|i| range.start + (i * (n - 1) + (k - 1) / 2) / (k - 1)).collect())
+            Ok((0..k)
+                .map(|i| range.start + (i * (n - 1) + (k - 1) / 2) / (k - 1))
+                .collect())
         }
     }
 }
@@ -80,11 +97,27 @@ mod tests {
 
     #[test]
     fn gif_frames_step_through_the_range() {
-        let o = RenderOptions { frame_step: 3, frame_range: Some(2..11), ..opts() };
+        let o = RenderOptions {
+            frame_step: 3,
+            frame_range: Some(2..11),
+            ..opts()
+        };
         assert_eq!(gif_frames(20, &o).unwrap(), vec![2, 5, 8]);
         assert!(gif_frames(10, &o).is_err());
-        assert!(gif_frames(20, &RenderOptions { frame_step: 0, ..opts() }).is_err());
-        let empty = RenderOptions { frame_range: Some(4..4), ..opts() };
+        assert!(
+            gif_frames(
+                20,
+                &RenderOptions {
+                    frame_step: 0,
+                    ..opts()
+                }
+            )
+            .is_err()
+        );
+        let empty = RenderOptions {
+            frame_range: Some(4..4),
+            ..opts()
+        };
         assert!(gif_frames(20, &empty).is_err());
     }
 
@@ -99,13 +132,30 @@ mod tests {
 
     #[test]
     fn strip_frames_are_evenly_spaced_with_both_ends() {
-        assert_eq!(strip_frames(200, &opts()).unwrap(), vec![0, 28, 57, 85, 114, 142, 171, 199]);
+        assert_eq!(
+            strip_frames(200, &opts()).unwrap(),
+            vec![0, 28, 57, 85, 114, 142, 171, 199]
+        );
         assert_eq!(strip_frames(3, &opts()).unwrap(), vec![0, 1, 2]);
         assert_eq!(strip_frames(1, &opts()).unwrap(), vec![0]);
-        let list = RenderOptions { strip_frames: StripFrames::Indices(vec![5, 1]), ..opts() };
+        let list = RenderOptions {
+            strip_frames: StripFrames::Indices(vec![5, 1]),
+            ..opts()
+        };
         assert_eq!(strip_frames(10, &list).unwrap(), vec![5, 1]);
-        assert!(matches!(strip_frames(5, &list), Err(RenderError::FrameOutOfRange { frame: 5, len: 5 })));
-        let zero = RenderOptions { strip_frames: StripFrames::Count(0), ..opts() };
+        assert!(matches!(
+            strip_frames(5, &list),
+            Err(RenderError::FrameOutOfRange { frame: 5, len: 5 })
+        ));
+        let zero = RenderOptions {
+            strip_frames: StripFrames::Count(0),
+            ..opts()
+        };
         assert!(strip_frames(10, &zero).is_err());
+        let many = RenderOptions {
+            strip_frames: StripFrames::Count(MAX_STRIP_FRAMES + 1),
+            ..opts()
+        };
+        assert!(strip_frames(1000, &many).is_err());
     }
 }

@@ -3,11 +3,13 @@
 //! and overlay lines and dots.
 
 use super::camera::View;
-use super::draw::{Area, CENTRE, TOP_LEFT, disc, line, polygon, polyline, ring, text};
+use super::draw::{Area, CENTRE, TOP_LEFT, disc, line, polygon, polyline, ring, text, veil};
 use super::error::RenderError;
 use super::overlay_geom::Prim;
 use super::scene::Scene;
-use super::style::{FLOOR, FLOOR_EDGE, FOOT, GRID, OVERLAY, SHADOW, SUBTLE, bone_width, fade, person_colors};
+use super::style::{
+    FLOOR, FLOOR_EDGE, FOOT, GRID, OVERLAY, SHADOW, SUBTLE, bone_width, fade, person_colors,
+};
 use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT, KINEMATIC_CHAINS};
 use glam::Vec3;
 use plotters::style::text_anchor::{HPos, VPos};
@@ -28,18 +30,30 @@ fn floor_corners(scene: &Scene) -> [Vec3; 4] {
     ]
 }
 
-/// Floor fill, grid lines on whole metres, border.
+/// Floor fill, grid lines every [`Scene::grid_step`] metres, border.
 pub(crate) fn draw_floor(area: &Area, scene: &Scene, view: &View) -> Result<(), RenderError> {
     let corners = floor_corners(scene);
     polygon(area, corners.iter().map(|c| view.px(*c)).collect(), FLOOR)?;
-    let (l, h) = (scene.floor_lo, scene.floor_hi);
-    for x in (l.x.ceil() as i64)..=(h.x.floor() as i64) {
-        let x = x as f32;
-        line(area, view.px(Vec3::new(x, 0.0, l.y)), view.px(Vec3::new(x, 0.0, h.y)), GRID, 1)?;
+    let (l, h, step) = (scene.floor_lo, scene.floor_hi, scene.grid_step());
+    for i in ((l.x / step).ceil() as i64)..=((h.x / step).floor() as i64) {
+        let x = i as f32 * step;
+        line(
+            area,
+            view.px(Vec3::new(x, 0.0, l.y)),
+            view.px(Vec3::new(x, 0.0, h.y)),
+            GRID,
+            1,
+        )?;
     }
-    for z in (l.y.ceil() as i64)..=(h.y.floor() as i64) {
-        let z = z as f32;
-        line(area, view.px(Vec3::new(l.x, 0.0, z)), view.px(Vec3::new(h.x, 0.0, z)), GRID, 1)?;
+    for i in ((l.y / step).ceil() as i64)..=((h.y / step).floor() as i64) {
+        let z = i as f32 * step;
+        line(
+            area,
+            view.px(Vec3::new(l.x, 0.0, z)),
+            view.px(Vec3::new(h.x, 0.0, z)),
+            GRID,
+            1,
+        )?;
     }
     let mut border: Vec<_> = corners.iter().map(|c| view.px(*c)).collect();
     border.push(border[0]);
@@ -48,11 +62,18 @@ pub(crate) fn draw_floor(area: &Area, scene: &Scene, view: &View) -> Result<(), 
 
 /// Metre labels along the bottom and left edges of the floor (top view only: its axes
 /// are world axes), spaced at least ~30 px apart.
-pub(crate) fn draw_metre_labels(area: &Area, scene: &Scene, view: &View, size: f64) -> Result<(), RenderError> {
+pub(crate) fn draw_metre_labels(
+    area: &Area,
+    scene: &Scene,
+    view: &View,
+    size: f64,
+) -> Result<(), RenderError> {
+    let base = scene.grid_step();
     let step = [1.0f32, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0]
         .into_iter()
+        .map(|m| m * base)
         .find(|s| s * view.scale >= 30.0)
-        .unwrap_or(200.0);
+        .unwrap_or(200.0 * base);
     let corners = floor_corners(scene).map(|c| view.pxf(c));
     let bottom = corners.iter().map(|c| c.1).fold(f32::MIN, f32::max);
     let left = corners.iter().map(|c| c.0).fold(f32::MAX, f32::min);
@@ -64,7 +85,9 @@ pub(crate) fn draw_metre_labels(area: &Area, scene: &Scene, view: &View, size: f
         let mut v = (lo / step).ceil() * step;
         while v <= hi + 1e-4 {
             let (x, y) = view.pxf(axis * v);
-            let label = format!("{}", v.round() as i64);
+            // `axis` is ±X or ±Z: the label is the world coordinate, not the projection.
+            let sign = axis.x + axis.y + axis.z;
+            let label = format!("{}", (v * sign).round() as i64);
             if horizontal {
                 let at = (x.round() as i32, bottom.round() as i32 + 2);
                 text(area, &label, at, size, SUBTLE, (HPos::Center, VPos::Top))?;
@@ -79,9 +102,19 @@ pub(crate) fn draw_metre_labels(area: &Area, scene: &Scene, view: &View, size: f
 }
 
 /// Each person's root path over the whole clip, on the floor.
-pub(crate) fn draw_trails(area: &Area, scene: &Scene, view: &View, width: u32, faded: f32) -> Result<(), RenderError> {
+pub(crate) fn draw_trails(
+    area: &Area,
+    scene: &Scene,
+    view: &View,
+    width: u32,
+    faded: f32,
+) -> Result<(), RenderError> {
     for person in 0..scene.people() {
-        let pts = scene.root_trail(person).into_iter().map(|p| view.px(on_floor(p))).collect();
+        let pts = scene
+            .root_trail(person)
+            .into_iter()
+            .map(|p| view.px(on_floor(p)))
+            .collect();
         polyline(area, pts, fade(person_colors(person).centre, faded), width)?;
     }
     Ok(())
@@ -89,7 +122,12 @@ pub(crate) fn draw_trails(area: &Area, scene: &Scene, view: &View, width: u32, f
 
 /// Every person's bones flattened onto the floor, with darker footprints (ankle to toe),
 /// so height above the floor and foot contacts can be read in the side view.
-pub(crate) fn draw_shadows(area: &Area, scene: &Scene, view: &View, frame: usize) -> Result<(), RenderError> {
+pub(crate) fn draw_shadows(
+    area: &Area,
+    scene: &Scene,
+    view: &View,
+    frame: usize,
+) -> Result<(), RenderError> {
     let width = bone_width(view.scale);
     for person in 0..scene.people() {
         let pose = scene.pose(person, frame);
@@ -98,17 +136,44 @@ pub(crate) fn draw_shadows(area: &Area, scene: &Scene, view: &View, frame: usize
             polyline(area, pts, SHADOW, width)?;
         }
         for [ankle, toe] in [FOOT_LEFT, FOOT_RIGHT] {
-            line(area, view.px(on_floor(pose[ankle])), view.px(on_floor(pose[toe])), FOOT, width)?;
+            line(
+                area,
+                view.px(on_floor(pose[ankle])),
+                view.px(on_floor(pose[toe])),
+                FOOT,
+                width,
+            )?;
         }
     }
     Ok(())
 }
 
-/// Overlay lines (planes, boxes, segments).
-pub(crate) fn draw_overlay_lines(area: &Area, scene: &Scene, view: &View) -> Result<(), RenderError> {
+/// Overlay lines and planes (planes as a light veil with an outline, so a wall reads as
+/// a surface; boxes and segments as lines). A plane seen edge-on or face-on from straight
+/// above (the top view) is a line or the whole floor: `from_above` draws walls as lines
+/// and leaves horizontal planes out.
+pub(crate) fn draw_overlay_lines(
+    area: &Area,
+    scene: &Scene,
+    view: &View,
+    from_above: bool,
+) -> Result<(), RenderError> {
     for prim in &scene.prims {
-        if let Prim::Line(a, b) = prim {
-            line(area, view.px(*a), view.px(*b), OVERLAY, 2)?;
+        match prim {
+            Prim::Line(a, b) => line(area, view.px(*a), view.px(*b), OVERLAY, 2)?,
+            Prim::Quad(q) if from_above => {
+                // A wall's bottom edge is its trace on the map; a horizontal plane has none.
+                if (q[2].y - q[1].y).abs() > 1e-6 {
+                    line(area, view.px(q[0]), view.px(q[1]), OVERLAY, 2)?;
+                }
+            }
+            Prim::Quad(q) => {
+                let mut pts: Vec<_> = q.iter().map(|p| view.px(*p)).collect();
+                veil(area, pts.clone(), OVERLAY, 0.08)?;
+                pts.push(pts[0]);
+                polyline(area, pts, OVERLAY, 1)?;
+            }
+            Prim::Dot(..) => {}
         }
     }
     Ok(())
@@ -136,15 +201,35 @@ pub(crate) fn draw_overlay_dots(
         disc(area, at, 4, OVERLAY)?;
         ring(area, at, 6, OVERLAY, 1)?;
         if let Some(label) = label {
-            text(area, label, (at.0 + 9, at.1 - 6), label_size, OVERLAY, TOP_LEFT)?;
+            text(
+                area,
+                label,
+                (at.0 + 9, at.1 - 6),
+                label_size,
+                OVERLAY,
+                TOP_LEFT,
+            )?;
         }
     }
     Ok(())
 }
 
 /// A numbered marker (strip top view: where each strip cell's frame is).
-pub(crate) fn draw_marker(area: &Area, at: (i32, i32), n: usize, color: plotters::style::RGBColor, size: f64) -> Result<(), RenderError> {
+pub(crate) fn draw_marker(
+    area: &Area,
+    at: (i32, i32),
+    n: usize,
+    color: plotters::style::RGBColor,
+    size: f64,
+) -> Result<(), RenderError> {
     let r = (size * 0.75).round() as i32;
     disc(area, at, r, color)?;
-    text(area, &n.to_string(), at, size, super::style::BACKGROUND, CENTRE)
+    text(
+        area,
+        &n.to_string(),
+        at,
+        size,
+        super::style::BACKGROUND,
+        CENTRE,
+    )
 }

@@ -52,6 +52,8 @@ mod views;
 #[cfg(test)]
 mod test_motion;
 #[cfg(test)]
+mod test_util;
+#[cfg(test)]
 mod tests;
 
 pub use animate::render_gif;
@@ -65,8 +67,15 @@ use std::path::Path;
 
 /// Renders by the extension of `path`: `.gif` → [`render_gif`], `.png` →
 /// [`render_strip_png`] (case-insensitive); anything else is [`RenderError::UnknownFormat`].
-pub fn render_to_path(people: &[Motion], opts: &RenderOptions, path: &Path) -> Result<(), RenderError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+pub fn render_to_path(
+    people: &[Motion],
+    opts: &RenderOptions,
+    path: &Path,
+) -> Result<(), RenderError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("gif") => render_gif(people, opts, path),
         Some("png") => render_strip_png(people, opts, path),

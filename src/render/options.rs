@@ -11,14 +11,16 @@ use std::ops::Range;
 pub struct RenderOptions {
     /// Caption drawn at the top (e.g. the prompt); empty for none.
     pub title: String,
-    /// GIF frame size in pixels (width, height): side view on the left, top view on the right.
+    /// GIF frame size in pixels (width, height): side view on the left, top view on the
+    /// right (stacked instead when the clip travels far enough that this draws it larger).
     pub size: (u32, u32),
     /// Width of the strip PNG in pixels; its height follows from the layout.
     pub strip_width: u32,
     /// GIF: draw every `frame_step`-th frame (1 = every frame). The GIF still plays at the
     /// motion's real speed: each GIF frame lasts `frame_step / fps` seconds.
     pub frame_step: usize,
-    /// Restrict both outputs to these frames (`None`: the whole clip).
+    /// Restrict both outputs to these frames (`None`: the whole clip). Cameras, floor and
+    /// trails still cover the whole clip, so renders of different ranges line up.
     pub frame_range: Option<Range<usize>>,
     /// Which frames the strip shows.
     pub strip_frames: StripFrames,
@@ -36,8 +38,8 @@ impl Default for RenderOptions {
             title: String::new(),
             size: (640, 320),
             strip_width: 1280,
-            // 10 fps keeps a 10 s clip around a megabyte and still reads as smooth motion.
-            frame_step: 2,
+            // Every frame: with changed-rectangle encoding a 10 s clip is a few hundred kB.
+            frame_step: 1,
             frame_range: None,
             strip_frames: StripFrames::Count(8),
             camera_yaw_deg: None,
@@ -49,16 +51,20 @@ impl Default for RenderOptions {
 impl RenderOptions {
     /// Default options with a caption.
     pub fn titled(title: impl Into<String>) -> Self {
-        RenderOptions { title: title.into(), ..Self::default() }
+        RenderOptions {
+            title: title.into(),
+            ..Self::default()
+        }
     }
 }
 
 /// Frames shown by the strip PNG.
 #[derive(Clone, Debug, PartialEq)]
 pub enum StripFrames {
-    /// This many evenly spaced frames, first and last included (fewer if the clip is shorter).
+    /// This many evenly spaced frames, first and last included (fewer if the clip is
+    /// shorter); at most 64.
     Count(usize),
-    /// Exactly these frame indices, in this order.
+    /// Exactly these frame indices, in this order; at most 64.
     Indices(Vec<usize>),
 }
 

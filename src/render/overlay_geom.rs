@@ -1,5 +1,5 @@
-//! Overlay geometry as drawable 3-D pieces: every [`Overlay`] becomes line segments and
-//! labelled dots in world coordinates, with unbounded planes clipped to the scene's floor
+//! Overlay geometry as drawable 3-D pieces: every [`Overlay`] becomes line segments,
+//! labelled dots and flat quadrilaterals in world coordinates, with unbounded planes clipped to the scene's floor
 //! rectangle and height range. Both views project these same pieces.
 
 use super::options::Overlay;
@@ -12,6 +12,19 @@ pub(crate) enum Prim {
     Line(Vec3, Vec3),
     /// A marked point with an optional label.
     Dot(Vec3, Option<String>),
+    /// A flat quadrilateral (a clipped plane), corners in order around its edge.
+    Quad([Vec3; 4]),
+}
+
+impl Prim {
+    /// Every corner or end point (what a camera must keep in view).
+    pub fn points(&self) -> Vec<Vec3> {
+        match self {
+            Prim::Line(a, b) => vec![*a, *b],
+            Prim::Dot(p, _) => vec![*p],
+            Prim::Quad(q) => q.to_vec(),
+        }
+    }
 }
 
 /// Turns overlays (already validated) into lines and dots inside the given floor
@@ -33,13 +46,23 @@ pub(crate) fn overlay_prims(
                 let base = Vec2::new(point.x, point.z);
                 if let Some((a, b)) = clip_line(base, along, floor_lo, floor_hi) {
                     let at = |p: Vec2, y: f32| Vec3::new(p.x, y, p.y);
-                    push_loop(&mut out, &[at(a, y_lo), at(b, y_lo), at(b, y_hi), at(a, y_hi)]);
+                    out.push(Prim::Quad([
+                        at(a, y_lo),
+                        at(b, y_lo),
+                        at(b, y_hi),
+                        at(a, y_hi),
+                    ]));
                 }
             }
             Overlay::HorizontalPlane { height } => {
                 let at = |x: f32, z: f32| Vec3::new(x, *height, z);
                 let (l, h) = (floor_lo, floor_hi);
-                push_loop(&mut out, &[at(l.x, l.y), at(h.x, l.y), at(h.x, h.y), at(l.x, h.y)]);
+                out.push(Prim::Quad([
+                    at(l.x, l.y),
+                    at(h.x, l.y),
+                    at(h.x, h.y),
+                    at(l.x, h.y),
+                ]));
             }
             Overlay::Box { min, max } => {
                 let corner = |i: usize| {
@@ -61,13 +84,6 @@ pub(crate) fn overlay_prims(
         }
     }
     out
-}
-
-/// Closed outline through `corners`.
-fn push_loop(out: &mut Vec<Prim>, corners: &[Vec3]) {
-    for (i, a) in corners.iter().enumerate() {
-        out.push(Prim::Line(*a, corners[(i + 1) % corners.len()]));
-    }
 }
 
 /// Part of the infinite line `base + s·dir` inside the rectangle (Liang–Barsky).
@@ -93,28 +109,47 @@ mod tests {
 
     #[test]
     fn wall_is_clipped_to_the_floor_rectangle() {
-        let wall = Overlay::VerticalPlane { point: Vec3::new(0.0, 0.0, 2.0), normal: Vec3::Z };
+        let wall = Overlay::VerticalPlane {
+            point: Vec3::new(0.0, 0.0, 2.0),
+            normal: Vec3::Z,
+        };
         let prims = overlay_prims(&[wall], Vec2::new(-1.0, 0.0), Vec2::new(3.0, 5.0), 0.0, 2.0);
-        assert_eq!(prims.len(), 4);
+        assert_eq!(prims.len(), 1);
         // The bottom edge runs along x at z = 2 across the whole floor width.
-        let Prim::Line(a, b) = &prims[0] else { panic!("expected a line") };
+        let Prim::Quad([a, b, c, _]) = &prims[0] else {
+            panic!("expected a quad")
+        };
+        assert_eq!(c.y, 2.0);
         let (xa, xb) = (a.x.min(b.x), a.x.max(b.x));
-        assert!((xa + 1.0).abs() < 1e-5 && (xb - 3.0).abs() < 1e-5, "{a} {b}");
+        assert!(
+            (xa + 1.0).abs() < 1e-5 && (xb - 3.0).abs() < 1e-5,
+            "{a} {b}"
+        );
         assert!((a.z - 2.0).abs() < 1e-5 && (b.z - 2.0).abs() < 1e-5);
         assert_eq!((a.y, b.y), (0.0, 0.0));
     }
 
     #[test]
     fn diagonal_wall_and_box_edges() {
-        let d = clip_line(Vec2::ZERO, Vec2::new(1.0, 1.0).normalize(), Vec2::splat(-1.0), Vec2::new(2.0, 0.5));
+        let d = clip_line(
+            Vec2::ZERO,
+            Vec2::new(1.0, 1.0).normalize(),
+            Vec2::splat(-1.0),
+            Vec2::new(2.0, 0.5),
+        );
         let (a, b) = d.unwrap();
         assert!((a - Vec2::splat(-1.0)).length() < 1e-5 && (b - Vec2::splat(0.5)).length() < 1e-5);
         assert!(clip_line(Vec2::new(5.0, 0.0), Vec2::Y, Vec2::ZERO, Vec2::ONE).is_none());
-        let bx = Overlay::Box { min: Vec3::ZERO, max: Vec3::ONE };
+        let bx = Overlay::Box {
+            min: Vec3::ZERO,
+            max: Vec3::ONE,
+        };
         let prims = overlay_prims(&[bx], Vec2::ZERO, Vec2::ONE, 0.0, 1.0);
         assert_eq!(prims.len(), 12);
         for p in prims {
-            let Prim::Line(a, b) = p else { panic!("expected a line") };
+            let Prim::Line(a, b) = p else {
+                panic!("expected a line")
+            };
             assert!(((a - b).length() - 1.0).abs() < 1e-6);
         }
     }

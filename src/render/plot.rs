@@ -2,7 +2,7 @@
 //! title and a legend, on a linear or logarithmic y axis — training loss curves and a
 //! program's per-statement error over time.
 
-use super::draw::render_rgb;
+use super::draw::{disc, line, polyline, render_rgb, text};
 use super::encode::encode_png;
 use super::error::{RenderError, draw_err};
 use super::font::{FAMILY, ensure_fonts};
@@ -10,6 +10,7 @@ use crate::fsutil::write_bytes_atomic;
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, VPos};
 use std::ops::Range;
 use std::path::Path;
 
@@ -33,7 +34,10 @@ pub struct PlotOptions {
 
 impl Default for PlotOptions {
     fn default() -> Self {
-        PlotOptions { size: (800, 480), log_y: false }
+        PlotOptions {
+            size: (800, 480),
+            log_y: false,
+        }
     }
 }
 
@@ -66,12 +70,18 @@ pub fn plot_lines(
     series: &[Series],
     opts: &PlotOptions,
 ) -> Result<(), RenderError> {
-    let is_png = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let is_png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if !is_png {
         return Err(RenderError::UnknownFormat(path.to_path_buf()));
     }
     let bytes = plot_png(title, x_label, y_label, series, opts)?;
-    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io { path: path.to_path_buf(), source })
+    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// The plot's PNG bytes.
@@ -84,30 +94,49 @@ pub(crate) fn plot_png(
 ) -> Result<Vec<u8>, RenderError> {
     let (w, h) = opts.size;
     if w < 200 || h < 150 {
-        return Err(RenderError::BadOption(format!("plot size {w}x{h} is too small (min 200x150)")));
+        return Err(RenderError::BadOption(format!(
+            "plot size {w}x{h} is too small (min 200x150)"
+        )));
     }
     let kept: Vec<Vec<(f32, f32)>> = series
         .iter()
         .map(|s| {
-            let keep = |&&(x, y): &&(f32, f32)| x.is_finite() && y.is_finite() && (!opts.log_y || y > 0.0);
+            let keep =
+                |&&(x, y): &&(f32, f32)| x.is_finite() && y.is_finite() && (!opts.log_y || y > 0.0);
             s.points.iter().filter(keep).copied().collect()
         })
         .collect();
     let all: Vec<(f32, f32)> = kept.iter().flatten().copied().collect();
     if all.is_empty() {
-        let why = if opts.log_y { "no finite positive points for a log-scale plot" } else { "no finite points" };
+        let why = if opts.log_y {
+            "no finite positive points for a log-scale plot"
+        } else {
+            "no finite points"
+        };
         return Err(RenderError::BadPlot(why.into()));
     }
     let xr = padded(all.iter().map(|p| p.0), false);
     let yr = padded(all.iter().map(|p| p.1), opts.log_y);
     ensure_fonts()?;
-    let labels = Labels { title, x: x_label, y: y_label };
+    let labels = Labels {
+        title,
+        x: x_label,
+        y: y_label,
+    };
     let rgb = render_rgb(w, h, |area| {
         area.fill(&WHITE).map_err(draw_err)?;
         if opts.log_y {
-            chart(area, &labels, xr, yr.log_scale(), series, &kept)
+            chart(
+                area,
+                &labels,
+                xr,
+                yr.clone().log_scale(),
+                Some(yr),
+                series,
+                &kept,
+            )
         } else {
-            chart(area, &labels, xr, yr, series, &kept)
+            chart(area, &labels, xr, yr, None, series, &kept)
         }
     })?;
     encode_png(&rgb, w, h)
@@ -150,11 +179,38 @@ fn tick(v: f32) -> String {
     }
 }
 
+/// Tick values for a log axis over `[lo, hi]`: decades, or 1-2-5, or 1…9 steps per
+/// decade, whichever first gives at least four ticks (at most ~12 kept); a range too
+/// narrow even for that gets five geometrically spaced ticks.
+fn log_ticks(lo: f32, hi: f32) -> Vec<f32> {
+    let (e0, e1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let steps: [&[f32]; 3] = [
+        &[1.0],
+        &[1.0, 2.0, 5.0],
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+    ];
+    for mults in steps {
+        let ticks: Vec<f32> = (e0..=e1)
+            .flat_map(|e| mults.iter().map(move |m| m * 10f32.powi(e)))
+            // Tolerate rounding at the ends (9 × 0.1 is not exactly 0.9 in f32).
+            .filter(|v| (lo * (1.0 - 1e-5)..=hi * (1.0 + 1e-5)).contains(v))
+            .collect();
+        if ticks.len() >= 4 {
+            let keep_every = ticks.len().div_ceil(12);
+            return ticks.into_iter().step_by(keep_every).collect();
+        }
+    }
+    (0..5)
+        .map(|i| lo * (hi / lo).powf(i as f32 / 4.0))
+        .collect()
+}
+
 fn chart<'a, Y>(
     area: &DrawingArea<BitMapBackend<'a>, Shift>,
     labels: &Labels,
     xr: Range<f32>,
     yr: Y,
+    log_ticks_in: Option<Range<f32>>,
     series: &[Series],
     kept: &[Vec<(f32, f32)>],
 ) -> Result<(), RenderError>
@@ -162,6 +218,7 @@ where
     Y: AsRangedCoord<Value = f32>,
     Y::CoordDescType: ValueFormatter<f32>,
 {
+    let x0 = xr.start;
     let mut chart = ChartBuilder::on(area)
         .caption(labels.title, (FAMILY, 18))
         .margin(12)
@@ -169,33 +226,56 @@ where
         .y_label_area_size(64)
         .build_cartesian_2d(xr, yr)
         .map_err(draw_err)?;
+    // Plotters labels a log axis only at powers of ten; its labels are blanked and the
+    // ticks drawn below instead.
+    let log = log_ticks_in.is_some();
+    let y_labels = if log { 0 } else { 8 };
     chart
         .configure_mesh()
         .x_desc(labels.x)
         .y_desc(labels.y)
         .x_labels(8)
-        .y_labels(8)
+        .y_labels(y_labels)
         .x_label_formatter(&|v| tick(*v))
-        .y_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| if log { String::new() } else { tick(*v) })
         .label_style((FAMILY, 12))
         .axis_desc_style((FAMILY, 14))
         .light_line_style(RGBColor(238, 238, 238))
         .bold_line_style(RGBColor(215, 215, 215))
         .draw()
         .map_err(draw_err)?;
+    if let Some(range) = log_ticks_in {
+        let right = chart.plotting_area().get_pixel_range().0.end;
+        for v in log_ticks(range.start, range.end) {
+            let (x, y) = chart.backend_coord(&(x0, v));
+            line(area, (x + 1, y), (right - 1, y), RGBColor(215, 215, 215), 1)?;
+            line(area, (x - 5, y), (x, y), RGBColor(0, 0, 0), 1)?;
+            text(
+                area,
+                &tick(v),
+                (x - 8, y),
+                12.0,
+                RGBColor(0, 0, 0),
+                (HPos::Right, VPos::Center),
+            )?;
+        }
+    }
     for (i, (s, pts)) in series.iter().zip(kept).enumerate() {
         let color = COLORS[i % COLORS.len()];
+        let px: Vec<(i32, i32)> = pts.iter().map(|p| chart.backend_coord(p)).collect();
+        // Drawn with the picture helpers: plotters' thick paths come out jagged.
+        polyline(area, px.clone(), color, 2)?;
+        if pts.len() <= MARK_POINTS_UP_TO {
+            for p in px {
+                disc(area, p, 3, color)?;
+            }
+        }
         let style = color.stroke_width(2);
         chart
-            .draw_series(LineSeries::new(pts.iter().copied(), style))
+            .draw_series(std::iter::empty::<PathElement<(f32, f32)>>())
             .map_err(draw_err)?
             .label(s.name.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-        if pts.len() <= MARK_POINTS_UP_TO {
-            chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
-                .map_err(draw_err)?;
-        }
     }
     chart
         .configure_series_labels()
@@ -210,6 +290,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::test_util::{decode_png, dir_entries, pixels_of};
 
     #[test]
     fn ranges_and_ticks() {
@@ -222,5 +303,64 @@ mod tests {
         assert_eq!(tick(3.0), "3");
         assert_eq!(tick(0.0), "0");
         assert_eq!(tick(1.5e-5), "1.5e-5");
+        let close = |a: &[f32], b: &[f32]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x / y - 1.0).abs() < 1e-5)
+        };
+        assert!(close(&log_ticks(1e-4, 2.0), &[1e-4, 1e-3, 1e-2, 1e-1, 1.0]));
+        assert!(close(&log_ticks(0.13, 3.2), &[0.2, 0.5, 1.0, 2.0]));
+        assert!(close(
+            &log_ticks(0.13, 0.9),
+            &[0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]
+        ));
+        assert!(log_ticks(1e-20, 1e20).len() <= 12);
+        let narrow = log_ticks(0.55, 0.6);
+        assert_eq!(narrow.len(), 5);
+        assert!((narrow[0] - 0.55).abs() < 1e-6 && (narrow[4] - 0.6).abs() < 1e-5);
+    }
+
+    #[test]
+    fn plot_lines_writes_a_png_and_rejects_bad_input() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("loss.png");
+        let train = Series {
+            name: "train".into(),
+            points: (1..200).map(|i| (i as f32, 5.0 / i as f32)).collect(),
+        };
+        let mut val_pts: Vec<(f32, f32)> = (1..20)
+            .map(|i| ((i * 10) as f32, 6.0 / (i * 10) as f32))
+            .collect();
+        val_pts.push((200.0, f32::NAN));
+        let val = Series {
+            name: "val".into(),
+            points: val_pts,
+        };
+        let opts = PlotOptions {
+            log_y: true,
+            ..PlotOptions::default()
+        };
+        plot_lines(&path, "loss", "step", "loss", &[train.clone(), val], &opts).unwrap();
+        let (w, h, rgb) = decode_png(&path);
+        assert_eq!((w, h), (800, 480));
+        // Both series are drawn in their colours.
+        assert!(pixels_of(&rgb, w, RGBColor(31, 119, 180)).len() > 200);
+        assert!(pixels_of(&rgb, w, RGBColor(255, 127, 14)).len() > 50);
+
+        let nan_only = Series {
+            name: "nan".into(),
+            points: vec![(0.0, f32::NAN)],
+        };
+        let bad = dir.path().join("bad.png");
+        assert!(matches!(
+            plot_lines(&bad, "t", "x", "y", &[nan_only], &PlotOptions::default()),
+            Err(RenderError::BadPlot(_))
+        ));
+        let negative = Series {
+            name: "neg".into(),
+            points: vec![(0.0, -1.0), (1.0, 0.0)],
+        };
+        assert!(plot_lines(&bad, "t", "x", "y", &[negative], &opts).is_err());
+        assert!(plot_lines(&dir.path().join("loss.gif"), "t", "x", "y", &[train], &opts).is_err());
+        assert!(!bad.exists());
+        assert_eq!(dir_entries(dir.path()), 1);
     }
 }

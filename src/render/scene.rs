@@ -22,10 +22,6 @@ pub(crate) struct Scene<'a> {
     pub fps: f32,
     /// Frames in the scene (the longest person; shorter ones hold their last pose).
     pub len: usize,
-    /// Lower corner of everything that must stay in view (floor included).
-    pub lo: Vec3,
-    /// Upper corner of everything that must stay in view.
-    pub hi: Vec3,
     /// Floor rectangle as (x, z) corners.
     pub floor_lo: Vec2,
     /// See `floor_lo`.
@@ -63,13 +59,23 @@ impl<'a> Scene<'a> {
         hi.y = hi.y.max(lo.y + 1.0);
         let floor_lo = Vec2::new(lo.x, lo.z) - FLOOR_MARGIN;
         let floor_hi = Vec2::new(hi.x, hi.z) + FLOOR_MARGIN;
-        lo = lo.min(Vec3::new(floor_lo.x, lo.y, floor_lo.y));
-        hi = hi.max(Vec3::new(floor_hi.x, hi.y, floor_hi.y));
         let prims = overlay_prims(&opts.overlays, floor_lo, floor_hi, lo.y, hi.y);
-        let mut scene = Scene { people, fps, len, lo, hi, floor_lo, floor_hi, prims, yaw: 0.0 };
+        let mut scene = Scene {
+            people,
+            fps,
+            len,
+            floor_lo,
+            floor_hi,
+            prims,
+            yaw: 0.0,
+        };
         scene.yaw = match opts.camera_yaw_deg {
             Some(d) if d.is_finite() => d.to_radians(),
-            Some(d) => return Err(RenderError::BadOption(format!("camera yaw {d} is not finite"))),
+            Some(d) => {
+                return Err(RenderError::BadOption(format!(
+                    "camera yaw {d} is not finite"
+                )));
+            }
             None => scene.auto_yaw(),
         };
         Ok(scene)
@@ -89,6 +95,35 @@ impl<'a> Scene<'a> {
     /// Root (pelvis) positions of `person` over the whole clip.
     pub fn root_trail(&self, person: usize) -> Vec<Vec3> {
         self.people[person].joint_track(0)
+    }
+
+    /// What the side camera must keep in view: the floor rectangle, every joint of every
+    /// frame, and the overlays. Fitting these rather than the bounding box leaves no empty
+    /// corners above the far end of a long walk.
+    pub fn fit_points(&self) -> Vec<Vec3> {
+        let (l, h) = (self.floor_lo, self.floor_hi);
+        let mut pts = vec![
+            Vec3::new(l.x, 0.0, l.y),
+            Vec3::new(h.x, 0.0, l.y),
+            Vec3::new(h.x, 0.0, h.y),
+            Vec3::new(l.x, 0.0, h.y),
+        ];
+        for m in self.people {
+            pts.extend(m.frames.iter().flatten());
+        }
+        pts.extend(self.prims.iter().flat_map(|p| p.points()));
+        pts
+    }
+
+    /// Spacing of the floor grid in metres: 1 m, or a power of ten keeping it to at
+    /// most 100 lines per axis on a huge floor (data in millimetres, say).
+    pub fn grid_step(&self) -> f32 {
+        let span = (self.floor_hi - self.floor_lo).max_element();
+        let mut step = 1.0;
+        while span / step > 100.0 {
+            step *= 10.0;
+        }
+        step
     }
 
     /// Seconds at `frame`.
@@ -132,11 +167,19 @@ fn validate_people(people: &[Motion]) -> Result<f32, RenderError> {
             return Err(RenderError::BadFps { person, fps: m.fps });
         }
         if (m.fps - first.fps).abs() > 1e-4 {
-            return Err(RenderError::FpsMismatch { person, fps: m.fps, first: first.fps });
+            return Err(RenderError::FpsMismatch {
+                person,
+                fps: m.fps,
+                first: first.fps,
+            });
         }
         for (frame, pose) in m.frames.iter().enumerate() {
             if let Some(joint) = pose.iter().position(|p| !p.is_finite()) {
-                return Err(RenderError::NonFinite { person, frame, joint });
+                return Err(RenderError::NonFinite {
+                    person,
+                    frame,
+                    joint,
+                });
             }
         }
     }
@@ -145,13 +188,18 @@ fn validate_people(people: &[Motion]) -> Result<f32, RenderError> {
 
 /// Points of an overlay that must be in view; rejects non-finite or degenerate overlays.
 fn anchor_points(o: &Overlay, index: usize) -> Result<Vec<Vec3>, RenderError> {
-    let bad = |reason: &str| RenderError::BadOverlay { index, reason: reason.to_string() };
+    let bad = |reason: &str| RenderError::BadOverlay {
+        index,
+        reason: reason.to_string(),
+    };
     let points = match o {
         Overlay::Point { at, .. } => vec![*at],
         Overlay::Segment { from, to } => vec![*from, *to],
         Overlay::VerticalPlane { point, normal } => {
             if !normal.is_finite() || Vec2::new(normal.x, normal.z).length() < 1e-6 {
-                return Err(bad("a vertical plane needs a finite normal with a horizontal part"));
+                return Err(bad(
+                    "a vertical plane needs a finite normal with a horizontal part",
+                ));
             }
             vec![*point]
         }
@@ -168,5 +216,55 @@ fn anchor_points(o: &Overlay, index: usize) -> Result<Vec<Vec3>, RenderError> {
         Ok(points)
     } else {
         Err(bad("coordinates are not finite"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::test_motion::{test_walk, walk};
+
+    #[test]
+    fn framing_covers_the_clip_and_follows_travel() {
+        let opts = RenderOptions::default();
+        let m = [test_walk()];
+        let s = Scene::new(&m, &opts).unwrap();
+        assert_eq!((s.len, s.people(), s.grid_step()), (40, 1, 1.0));
+        let (lo, hi) = m[0].bounds();
+        assert!(s.floor_lo.x < lo.x && s.floor_hi.y > hi.z);
+        // Walking along +Z gives heading 0; along +X a quarter turn.
+        assert!(s.yaw.abs() < 1e-3);
+        let along_x = [walk(40, 1.2, Vec3::ZERO, Vec3::X)];
+        let sx = Scene::new(&along_x, &opts).unwrap();
+        assert!((sx.yaw - std::f32::consts::FRAC_PI_2).abs() < 1e-3);
+        // An explicit yaw wins; a shorter person holds their last pose.
+        let two = [test_walk(), walk(10, 1.0, Vec3::X, Vec3::Z)];
+        let st = Scene::new(
+            &two,
+            &RenderOptions {
+                camera_yaw_deg: Some(90.0),
+                ..opts.clone()
+            },
+        )
+        .unwrap();
+        assert!((st.yaw - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        assert_eq!(st.pose(1, 30), &two[1].frames[9]);
+        // Millimetre-sized data gets a coarser grid instead of thousands of lines.
+        let mm = [Motion::new(
+            test_walk()
+                .frames
+                .iter()
+                .map(|p| p.map(|v| v * 1000.0))
+                .collect(),
+        )];
+        assert!(Scene::new(&mm, &opts).unwrap().grid_step() >= 100.0);
+    }
+
+    #[test]
+    fn facing_follows_the_hips_and_shoulders() {
+        let f = facing(&crate::skeleton::rest_pose()).unwrap();
+        assert!((f - Vec3::Z).length() < 1e-5);
+        let turned = walk(2, 0.0, Vec3::ZERO, Vec3::NEG_X);
+        assert!((facing(&turned.frames[0]).unwrap() - Vec3::NEG_X).length() < 1e-4);
     }
 }

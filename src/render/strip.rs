@@ -12,7 +12,9 @@ use super::frames::strip_frames;
 use super::options::RenderOptions;
 use super::scene::Scene;
 use super::style::{GRID, TEXT};
-use super::views::{TopMarks, draw_caption, draw_side, draw_top, label_height, side_view, top_caption, top_view};
+use super::views::{
+    TopMarks, draw_caption, draw_side, draw_top, label_height, side_view, top_caption, top_view,
+};
 use crate::fsutil::write_bytes_atomic;
 use crate::motion::Motion;
 use std::path::Path;
@@ -36,7 +38,9 @@ impl Layout {
     /// most 1.5× as tall as it is wide.
     fn new(scene: &Scene, k: usize, width: u32) -> Result<Layout, RenderError> {
         if !(320..=8192).contains(&width) {
-            return Err(RenderError::BadOption(format!("strip width {width} is outside 320..=8192")));
+            return Err(RenderError::BadOption(format!(
+                "strip width {width} is outside 320..=8192"
+            )));
         }
         let wf = width as f32;
         let title_h = (FONT * 1.9).round() as f32;
@@ -49,29 +53,58 @@ impl Layout {
             (span(basis.right).max(1e-3), span(basis.up).max(1e-3))
         };
         let side = Basis::side(scene.yaw);
-        let (du, dv) = extent(side, &box_corners(scene.lo, scene.hi));
-        let cell_h = |c: usize| (wf / c as f32 - 2.0 * CELL_MARGIN) * dv / du + 2.0 * CELL_MARGIN + lh;
+        let (du, dv) = extent(side, &scene.fit_points());
+        let cell_h =
+            |c: usize| (wf / c as f32 - 2.0 * CELL_MARGIN) * dv / du + 2.0 * CELL_MARGIN + lh;
         let rows = |c: usize| k.div_ceil(c);
-        let cols = (1..=k).find(|&c| rows(c) as f32 * cell_h(c) <= 1.5 * wf).unwrap_or(k);
+        let cols = (1..=k)
+            .find(|&c| rows(c) as f32 * cell_h(c) <= 1.5 * wf)
+            .unwrap_or(k);
         let (cw, ch) = ((wf / cols as f32).floor(), cell_h(cols).ceil());
         let cells = (0..k)
-            .map(|i| Rect { x: (i % cols) as f32 * cw, y: title_h + (i / cols) as f32 * ch, w: cw, h: ch })
+            .map(|i| Rect {
+                x: (i % cols) as f32 * cw,
+                y: title_h + (i / cols) as f32 * ch,
+                w: cw,
+                h: ch,
+            })
             .collect();
         let (l, h) = (scene.floor_lo, scene.floor_hi);
-        let floor = box_corners(glam::Vec3::new(l.x, 0.0, l.y), glam::Vec3::new(h.x, 0.0, h.y));
+        let floor = box_corners(
+            glam::Vec3::new(l.x, 0.0, l.y),
+            glam::Vec3::new(h.x, 0.0, h.y),
+        );
         let (tu, tv) = extent(Basis::top(&side), &floor);
         let top_h = (wf * tv / tu).clamp(0.2 * wf, 0.35 * wf).round();
-        let top = Rect { x: 0.0, y: title_h + rows(cols) as f32 * ch, w: wf, h: top_h };
-        Ok(Layout { w: width, h: (top.y + top.h).ceil() as u32, title_h, cells, top })
+        let top = Rect {
+            x: 0.0,
+            y: title_h + rows(cols) as f32 * ch,
+            w: wf,
+            h: top_h,
+        };
+        Ok(Layout {
+            w: width,
+            h: (top.y + top.h).ceil() as u32,
+            title_h,
+            cells,
+            top,
+        })
     }
 }
 
 /// Renders `people` as one PNG at `path`: `opts.strip_frames` side views sharing one
 /// camera, plus the top view of the trails, `opts.strip_width` pixels wide.
 /// Nothing is written when an error is returned.
-pub fn render_strip_png(people: &[Motion], opts: &RenderOptions, path: &Path) -> Result<(), RenderError> {
+pub fn render_strip_png(
+    people: &[Motion],
+    opts: &RenderOptions,
+    path: &Path,
+) -> Result<(), RenderError> {
     let bytes = strip_bytes(people, opts)?;
-    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io { path: path.to_path_buf(), source })
+    write_bytes_atomic(path, &bytes).map_err(|source| RenderError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// The strip PNG file's bytes.
@@ -80,27 +113,46 @@ pub(crate) fn strip_bytes(people: &[Motion], opts: &RenderOptions) -> Result<Vec
     let frames = strip_frames(scene.len, opts)?;
     let layout = Layout::new(&scene, frames.len(), opts.strip_width)?;
     ensure_fonts()?;
-    let rgb = render_rgb(layout.w, layout.h, |area| paint(area, &scene, &layout, &frames, &opts.title))?;
+    let rgb = render_rgb(layout.w, layout.h, |area| {
+        paint(area, &scene, &layout, &frames, &opts.title)
+    })?;
     encode_png(&rgb, layout.w, layout.h)
 }
 
-fn paint(area: &Area, scene: &Scene, layout: &Layout, frames: &[usize], title: &str) -> Result<(), RenderError> {
+fn paint(
+    area: &Area,
+    scene: &Scene,
+    layout: &Layout,
+    frames: &[usize],
+    title: &str,
+) -> Result<(), RenderError> {
     let y = ((f64::from(layout.title_h) - FONT) / 2.0).round() as i32;
     let title = fit_text(title, FONT, f64::from(layout.w) - 12.0);
     text(area, &title, (6, y), FONT, TEXT, TOP_LEFT)?;
     let small = FONT * 0.8;
     let lh = label_height(small);
     for (k, (&cell, &frame)) in layout.cells.iter().zip(frames).enumerate() {
-        let inner = Rect { y: cell.y + lh, h: cell.h - lh, ..cell };
+        let inner = Rect {
+            y: cell.y + lh,
+            h: cell.h - lh,
+            ..cell
+        };
         let view = side_view(scene, inner);
         draw_side(area, scene, &view, frame, small)?;
-        let caption = format!("#{}  {:.2} s  (frame {frame})", k + 1, scene.time(frame));
+        let caption = format!("#{}   {:.2} s   frame {frame}", k + 1, scene.time(frame));
         draw_caption(area, cell, &caption, small)?;
         outline(area, cell)?;
     }
-    let view = top_view(scene, Rect { y: layout.top.y + lh, h: layout.top.h - lh, ..layout.top });
+    let view = top_view(
+        scene,
+        Rect {
+            y: layout.top.y + lh,
+            h: layout.top.h - lh,
+            ..layout.top
+        },
+    );
     draw_top(area, scene, &view, TopMarks::Numbered(frames), small)?;
-    draw_caption(area, layout.top, &top_caption(&view), small)?;
+    draw_caption(area, layout.top, &top_caption(scene, &view), small)?;
     outline(area, layout.top)
 }
 
@@ -108,5 +160,10 @@ fn paint(area: &Area, scene: &Scene, layout: &Layout, frames: &[usize], title: &
 fn outline(area: &Area, r: Rect) -> Result<(), RenderError> {
     let (x0, y0) = (r.x as i32, r.y as i32);
     let (x1, y1) = ((r.x + r.w) as i32 - 1, (r.y + r.h) as i32 - 1);
-    polyline(area, vec![(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)], GRID, 1)
+    polyline(
+        area,
+        vec![(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)],
+        GRID,
+        1,
+    )
 }

@@ -38,14 +38,38 @@ pub(crate) struct PersonColors {
 /// Colour family of person `i` (cycles after five people).
 pub(crate) fn person_colors(i: usize) -> PersonColors {
     const FAMILIES: [(RGBColor, RGBColor, RGBColor); 5] = [
-        (RGBColor(20, 70, 170), RGBColor(110, 170, 250), RGBColor(45, 110, 210)), // blue
-        (RGBColor(170, 30, 30), RGBColor(250, 135, 115), RGBColor(215, 70, 60)),  // red
-        (RGBColor(20, 115, 45), RGBColor(120, 210, 125), RGBColor(55, 160, 80)),  // green
-        (RGBColor(105, 40, 150), RGBColor(195, 150, 235), RGBColor(150, 90, 200)), // purple
-        (RGBColor(175, 95, 0), RGBColor(250, 190, 90), RGBColor(220, 140, 30)),   // orange
+        (
+            RGBColor(20, 70, 170),
+            RGBColor(110, 170, 250),
+            RGBColor(45, 110, 210),
+        ), // blue
+        (
+            RGBColor(170, 30, 30),
+            RGBColor(250, 135, 115),
+            RGBColor(215, 70, 60),
+        ), // red
+        (
+            RGBColor(20, 115, 45),
+            RGBColor(120, 210, 125),
+            RGBColor(55, 160, 80),
+        ), // green
+        (
+            RGBColor(105, 40, 150),
+            RGBColor(195, 150, 235),
+            RGBColor(150, 90, 200),
+        ), // purple
+        (
+            RGBColor(175, 95, 0),
+            RGBColor(250, 190, 90),
+            RGBColor(220, 140, 30),
+        ), // orange
     ];
     let (right, left, centre) = FAMILIES[i % FAMILIES.len()];
-    PersonColors { right, left, centre }
+    PersonColors {
+        right,
+        left,
+        centre,
+    }
 }
 
 /// Which side of the body a kinematic chain belongs to.
@@ -102,7 +126,16 @@ mod tests {
     fn chain_sides_match_the_skeleton_table() {
         // t2m chains: right leg, left leg, spine, right arm, left arm.
         let sides: Vec<Side> = (0..KINEMATIC_CHAINS.len()).map(chain_side).collect();
-        assert_eq!(sides, [Side::Right, Side::Left, Side::Centre, Side::Right, Side::Left]);
+        assert_eq!(
+            sides,
+            [
+                Side::Right,
+                Side::Left,
+                Side::Centre,
+                Side::Right,
+                Side::Left
+            ]
+        );
     }
 
     #[test]

@@ -18,7 +18,9 @@ pub(crate) fn walk(frames: usize, speed: f32, start: Vec3, dir: Vec3) -> Motion 
             .map(|i| {
                 let t = i as f32 / crate::skeleton::FPS;
                 let phase = TAU * t;
-                let root = start + dir * speed * t + Vec3::Y * (REST_PELVIS_HEIGHT + 0.02 * (2.0 * phase).cos() * swing);
+                let root = start
+                    + dir * speed * t
+                    + Vec3::Y * (REST_PELVIS_HEIGHT + 0.02 * (2.0 * phase).cos() * swing);
                 pose(root, heading, phase, swing)
             })
             .collect(),
@@ -76,7 +78,10 @@ mod tests {
                 }
             }
             assert!(pose[15].y > pose[0].y && pose[0].y > pose[7].y);
-            assert!(pose[1].x > pose[2].x, "left hip must be at +X when facing +Z");
+            assert!(
+                pose[1].x > pose[2].x,
+                "left hip must be at +X when facing +Z"
+            );
         }
         assert!(m.frames[39][0].z - m.frames[0][0].z > 2.0);
         // The legs swing: the left ankle is ahead of the right at a quarter cycle.

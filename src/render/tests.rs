@@ -8,80 +8,22 @@ use super::draw::render_rgb;
 use super::scene::Scene;
 use super::style::{OVERLAY, person_colors};
 use super::test_motion::{test_walk, walk};
+use super::test_util::{decode_gif, decode_png, dir_entries, mean, pixels_of};
 use super::views::{TopMarks, draw_side, draw_top, side_view, top_view};
 use super::*;
 use crate::motion::Motion;
 use crate::skeleton::rest_pose;
 use glam::Vec3;
-use plotters::style::RGBColor;
 use std::path::Path;
-
-/// A decoded GIF: size, per-frame delays and the composited RGB picture after each frame.
-struct DecodedGif {
-    w: usize,
-    h: usize,
-    delays: Vec<u16>,
-    frames: Vec<Vec<u8>>,
-}
-
-fn decode_gif(path: &Path) -> DecodedGif {
-    let mut opts = gif::DecodeOptions::new();
-    opts.set_color_output(gif::ColorOutput::Indexed);
-    let mut dec = opts.read_info(std::fs::File::open(path).unwrap()).unwrap();
-    let (w, h) = (usize::from(dec.width()), usize::from(dec.height()));
-    let palette = dec.global_palette().unwrap().to_vec();
-    let mut canvas = vec![0u8; w * h * 3];
-    let (mut delays, mut frames) = (Vec::new(), Vec::new());
-    while let Some(f) = dec.read_next_frame().unwrap() {
-        for y in 0..usize::from(f.height) {
-            for x in 0..usize::from(f.width) {
-                let i = f.buffer[y * usize::from(f.width) + x];
-                if Some(i) == f.transparent {
-                    continue;
-                }
-                let at = ((y + usize::from(f.top)) * w + x + usize::from(f.left)) * 3;
-                canvas[at..at + 3].copy_from_slice(&palette[usize::from(i) * 3..usize::from(i) * 3 + 3]);
-            }
-        }
-        delays.push(f.delay);
-        frames.push(canvas.clone());
-    }
-    DecodedGif { w, h, delays, frames }
-}
-
-fn decode_png(path: &Path) -> (usize, usize, Vec<u8>) {
-    let dec = png::Decoder::new(std::fs::File::open(path).unwrap());
-    let mut reader = dec.read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, png::ColorType::Rgb);
-    buf.truncate(info.buffer_size());
-    (info.width as usize, info.height as usize, buf)
-}
-
-/// Pixel positions (x, y) of an exact colour in a packed RGB picture of width `w`.
-fn pixels_of(rgb: &[u8], w: usize, c: RGBColor) -> Vec<(usize, usize)> {
-    rgb.chunks_exact(3)
-        .enumerate()
-        .filter(|(_, p)| p[0] == c.0 && p[1] == c.1 && p[2] == c.2)
-        .map(|(i, _)| (i % w, i / w))
-        .collect()
-}
-
-fn mean(v: &[(usize, usize)]) -> (f32, f32) {
-    let n = v.len().max(1) as f32;
-    (v.iter().map(|p| p.0 as f32).sum::<f32>() / n, v.iter().map(|p| p.1 as f32).sum::<f32>() / n)
-}
-
-fn dir_entries(dir: &Path) -> usize {
-    std::fs::read_dir(dir).unwrap().count()
-}
 
 #[test]
 fn gif_round_trip_has_every_frame_real_time_and_motion() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("walk.gif");
-    let opts = RenderOptions::titled("a person walks forward");
+    let opts = RenderOptions {
+        frame_step: 2,
+        ..RenderOptions::titled("a person walks forward")
+    };
     render_gif(&[test_walk()], &opts, &path).unwrap();
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..6], b"GIF89a");
@@ -90,13 +32,24 @@ fn gif_round_trip_has_every_frame_real_time_and_motion() {
     // 40 frames at step 2 → 20 GIF frames of 0.1 s: 2 s in total.
     assert_eq!(g.frames.len(), 20);
     assert!(g.delays.iter().all(|&d| d == 10), "{:?}", g.delays);
-    let changed = |a: &[u8], b: &[u8]| a.chunks_exact(3).zip(b.chunks_exact(3)).filter(|(p, q)| p != q).count();
+    let changed = |a: &[u8], b: &[u8]| {
+        a.chunks_exact(3)
+            .zip(b.chunks_exact(3))
+            .filter(|(p, q)| p != q)
+            .count()
+    };
     for k in 1..g.frames.len() {
-        assert!(changed(&g.frames[k - 1], &g.frames[k]) > 50, "frame {k} did not change");
+        assert!(
+            changed(&g.frames[k - 1], &g.frames[k]) > 50,
+            "frame {k} did not change"
+        );
     }
     // The figure moves rightwards in the side view (left 60 % of the picture).
     let side_x = |rgb: &[u8]| {
-        let px: Vec<_> = pixels_of(rgb, g.w, person_colors(0).right).into_iter().filter(|p| p.0 < 384).collect();
+        let px: Vec<_> = pixels_of(rgb, g.w, person_colors(0).right)
+            .into_iter()
+            .filter(|p| p.0 < 384)
+            .collect();
         mean(&px).0
     };
     assert!(side_x(&g.frames[19]) > side_x(&g.frames[0]) + 40.0);
@@ -112,9 +65,18 @@ fn strip_png_shows_both_sides_people_and_overlays() {
     let plain = dir.path().join("plain.png");
     render_strip_png(&[a.clone(), b.clone()], &opts, &plain).unwrap();
     opts.overlays = vec![
-        Overlay::Point { at: Vec3::new(0.0, 1.0, 2.0), label: Some("target".into()) },
-        Overlay::VerticalPlane { point: Vec3::new(0.0, 0.0, 3.0), normal: Vec3::Z },
-        Overlay::Box { min: Vec3::new(-0.5, 0.0, 0.5), max: Vec3::new(0.5, 0.5, 1.0) },
+        Overlay::Point {
+            at: Vec3::new(0.0, 1.0, 2.0),
+            label: Some("target".into()),
+        },
+        Overlay::VerticalPlane {
+            point: Vec3::new(0.0, 0.0, 3.0),
+            normal: Vec3::Z,
+        },
+        Overlay::Box {
+            min: Vec3::new(-0.5, 0.0, 0.5),
+            max: Vec3::new(0.5, 0.5, 1.0),
+        },
     ];
     let with = dir.path().join("overlays.png");
     render_strip_png(&[a, b], &opts, &with).unwrap();
@@ -124,8 +86,14 @@ fn strip_png_shows_both_sides_people_and_overlays() {
     assert!(h > 200 && h < 3000, "height {h}");
     for person in 0..2 {
         let c = person_colors(person);
-        assert!(pixels_of(&rgb, w, c.left).len() > 100, "person {person} left side missing");
-        assert!(pixels_of(&rgb, w, c.right).len() > 100, "person {person} right side missing");
+        assert!(
+            pixels_of(&rgb, w, c.left).len() > 100,
+            "person {person} left side missing"
+        );
+        assert!(
+            pixels_of(&rgb, w, c.right).len() > 100,
+            "person {person} right side missing"
+        );
     }
     assert!(pixels_of(&rgb, w, OVERLAY).is_empty());
     let (w2, _, rgb2) = decode_png(&with);
@@ -136,10 +104,21 @@ fn strip_png_shows_both_sides_people_and_overlays() {
 fn view_pixels(people: &[Motion], top: bool, frame: usize) -> Vec<u8> {
     let opts = RenderOptions::default();
     let scene = Scene::new(people, &opts).unwrap();
-    let rect = Rect { x: 0.0, y: 0.0, w: 400.0, h: 300.0 };
+    let rect = Rect {
+        x: 0.0,
+        y: 0.0,
+        w: 400.0,
+        h: 300.0,
+    };
     render_rgb(400, 300, |area| {
         if top {
-            draw_top(area, &scene, &top_view(&scene, rect), TopMarks::Current(frame), 11.0)
+            draw_top(
+                area,
+                &scene,
+                &top_view(&scene, rect),
+                TopMarks::Current(frame),
+                11.0,
+            )
         } else {
             draw_side(area, &scene, &side_view(&scene, rect), frame, 11.0)
         }
@@ -154,27 +133,51 @@ fn views_are_upright_and_not_mirrored() {
     // Side view: the head (spine colour, topmost) is above the legs.
     let side = view_pixels(std::slice::from_ref(&still), false, 0);
     let centre = pixels_of(&side, 400, c.centre);
-    let legs: Vec<_> = pixels_of(&side, 400, c.right).into_iter().chain(pixels_of(&side, 400, c.left)).collect();
+    let legs: Vec<_> = pixels_of(&side, 400, c.right)
+        .into_iter()
+        .chain(pixels_of(&side, 400, c.left))
+        .collect();
     let head_top = centre.iter().map(|p| p.1).min().unwrap();
     let lowest_limb = legs.iter().map(|p| p.1).max().unwrap();
-    assert!(head_top + 100 < lowest_limb, "figure is not upright: head {head_top}, feet {lowest_limb}");
+    assert!(
+        head_top + 100 < lowest_limb,
+        "figure is not upright: head {head_top}, feet {lowest_limb}"
+    );
     // Top view of someone facing +Z (screen right): their left (+X) is up on screen.
     let top = view_pixels(&[still], true, 0);
-    let (left, right) = (mean(&pixels_of(&top, 400, c.left)), mean(&pixels_of(&top, 400, c.right)));
-    assert!(left.1 + 5.0 < right.1, "left side {left:?} must be above right side {right:?}");
+    let (left, right) = (
+        mean(&pixels_of(&top, 400, c.left)),
+        mean(&pixels_of(&top, 400, c.right)),
+    );
+    assert!(
+        left.1 + 5.0 < right.1,
+        "left side {left:?} must be above right side {right:?}"
+    );
 }
 
 #[test]
 fn render_to_path_dispatches_on_extension() {
     let dir = tempfile::tempdir().unwrap();
     let m = [Motion::new(vec![rest_pose(); 4])];
-    let opts = RenderOptions { frame_step: 1, ..RenderOptions::default() };
+    let opts = RenderOptions {
+        frame_step: 1,
+        ..RenderOptions::default()
+    };
     render_to_path(&m, &opts, &dir.path().join("a.GIF")).unwrap();
     render_to_path(&m, &opts, &dir.path().join("sub/a.png")).unwrap();
-    assert_eq!(&std::fs::read(dir.path().join("a.GIF")).unwrap()[..6], b"GIF89a");
-    assert_eq!(&std::fs::read(dir.path().join("sub/a.png")).unwrap()[..4], b"\x89PNG");
+    assert_eq!(
+        &std::fs::read(dir.path().join("a.GIF")).unwrap()[..6],
+        b"GIF89a"
+    );
+    assert_eq!(
+        &std::fs::read(dir.path().join("sub/a.png")).unwrap()[..4],
+        b"\x89PNG"
+    );
     let bad = dir.path().join("a.jpg");
-    assert!(matches!(render_to_path(&m, &opts, &bad), Err(RenderError::UnknownFormat(_))));
+    assert!(matches!(
+        render_to_path(&m, &opts, &bad),
+        Err(RenderError::UnknownFormat(_))
+    ));
     assert!(!bad.exists());
 }
 
@@ -188,11 +191,25 @@ fn bad_motions_are_errors_and_write_nothing() {
     nan.frames[7][3].y = f32::NAN;
     let mut slow = test_walk();
     slow.fps = 10.0;
-    let cases: Vec<(Vec<Motion>, fn(&RenderError) -> bool)> = vec![
+    type Expect = fn(&RenderError) -> bool;
+    let cases: Vec<(Vec<Motion>, Expect)> = vec![
         (vec![], |e| matches!(e, RenderError::NoPeople)),
-        (vec![Motion::new(vec![])], |e| matches!(e, RenderError::EmptyMotion { person: 0 })),
-        (vec![test_walk(), nan], |e| matches!(e, RenderError::NonFinite { person: 1, frame: 7, joint: 3 })),
-        (vec![test_walk(), slow], |e| matches!(e, RenderError::FpsMismatch { person: 1, .. })),
+        (vec![Motion::new(vec![])], |e| {
+            matches!(e, RenderError::EmptyMotion { person: 0 })
+        }),
+        (vec![test_walk(), nan], |e| {
+            matches!(
+                e,
+                RenderError::NonFinite {
+                    person: 1,
+                    frame: 7,
+                    joint: 3
+                }
+            )
+        }),
+        (vec![test_walk(), slow], |e| {
+            matches!(e, RenderError::FpsMismatch { person: 1, .. })
+        }),
     ];
     for (people, expected) in cases {
         for path in [&gif, &png] {
@@ -202,52 +219,136 @@ fn bad_motions_are_errors_and_write_nothing() {
     }
     let walk = [test_walk()];
     let bad_opts = [
-        RenderOptions { frame_step: 0, ..RenderOptions::default() },
-        RenderOptions { frame_range: Some(10..100), ..RenderOptions::default() },
-        RenderOptions { size: (10, 10), ..RenderOptions::default() },
-        RenderOptions { strip_frames: StripFrames::Indices(vec![3, 40]), ..RenderOptions::default() },
-        RenderOptions { camera_yaw_deg: Some(f32::NAN), ..RenderOptions::default() },
         RenderOptions {
-            overlays: vec![Overlay::VerticalPlane { point: Vec3::ZERO, normal: Vec3::Y }],
+            frame_step: 0,
             ..RenderOptions::default()
         },
         RenderOptions {
-            overlays: vec![Overlay::Point { at: Vec3::splat(f32::INFINITY), label: None }],
+            frame_range: Some(10..100),
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            size: (10, 10),
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            strip_frames: StripFrames::Indices(vec![3, 40]),
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            camera_yaw_deg: Some(f32::NAN),
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            overlays: vec![Overlay::VerticalPlane {
+                point: Vec3::ZERO,
+                normal: Vec3::Y,
+            }],
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            overlays: vec![Overlay::Point {
+                at: Vec3::splat(f32::INFINITY),
+                label: None,
+            }],
             ..RenderOptions::default()
         },
     ];
     for (i, o) in bad_opts.iter().enumerate() {
         let path = if i == 3 { &png } else { &gif };
-        assert!(render_to_path(&walk, o, path).is_err(), "options {i} should be rejected");
+        assert!(
+            render_to_path(&walk, o, path).is_err(),
+            "options {i} should be rejected"
+        );
     }
     assert_eq!(dir_entries(dir.path()), 0, "an error left a file behind");
 }
 
+/// Writes demo renders for looking at by eye (`cargo test --lib render::tests::demo --
+/// --ignored`): into `$MPROG_RENDER_DEMO` or `/tmp/mprog-render-demo`, GIF frames also as PNG.
 #[test]
-fn plot_lines_writes_a_png_and_rejects_bad_input() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("loss.png");
-    let train = Series { name: "train".into(), points: (1..200).map(|i| (i as f32, 5.0 / i as f32)).collect() };
-    let mut val_pts: Vec<(f32, f32)> = (1..20).map(|i| ((i * 10) as f32, 6.0 / (i * 10) as f32)).collect();
-    val_pts.push((200.0, f32::NAN));
-    let val = Series { name: "val".into(), points: val_pts };
-    let opts = PlotOptions { log_y: true, ..PlotOptions::default() };
-    plot_lines(&path, "loss", "step", "loss", &[train.clone(), val], &opts).unwrap();
-    let (w, h, rgb) = decode_png(&path);
-    assert_eq!((w, h), (800, 480));
-    // Both series are drawn in their colours.
-    assert!(pixels_of(&rgb, w, RGBColor(31, 119, 180)).len() > 200);
-    assert!(pixels_of(&rgb, w, RGBColor(255, 127, 14)).len() > 50);
-
-    let nan_only = Series { name: "nan".into(), points: vec![(0.0, f32::NAN)] };
-    let bad = dir.path().join("bad.png");
-    assert!(matches!(
-        plot_lines(&bad, "t", "x", "y", &[nan_only], &PlotOptions::default()),
-        Err(RenderError::BadPlot(_))
-    ));
-    let negative = Series { name: "neg".into(), points: vec![(0.0, -1.0), (1.0, 0.0)] };
-    assert!(plot_lines(&bad, "t", "x", "y", &[negative], &opts).is_err());
-    assert!(plot_lines(&dir.path().join("loss.gif"), "t", "x", "y", &[train], &opts).is_err());
-    assert!(!bad.exists());
-    assert_eq!(dir_entries(dir.path()), 1);
+#[ignore = "writes pictures for manual inspection"]
+fn demo_renders_for_inspection() {
+    let dir =
+        std::env::var("MPROG_RENDER_DEMO").unwrap_or_else(|_| "/tmp/mprog-render-demo".into());
+    let dir = Path::new(&dir);
+    let long_walk = walk(200, 1.2, Vec3::ZERO, Vec3::Z);
+    let rest = Motion::new(vec![rest_pose(); 20]);
+    let diagonal = walk(60, 1.0, Vec3::new(0.5, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.6));
+    let other = walk(60, 0.9, Vec3::new(2.0, 0.0, 3.0), Vec3::NEG_Z);
+    let mut opts = RenderOptions::titled("a person walks forward for ten seconds");
+    render_to_path(
+        std::slice::from_ref(&long_walk),
+        &opts,
+        &dir.join("walk.gif"),
+    )
+    .unwrap();
+    render_to_path(&[long_walk], &opts, &dir.join("walk.png")).unwrap();
+    opts.title = "rest pose".into();
+    render_to_path(std::slice::from_ref(&rest), &opts, &dir.join("rest.gif")).unwrap();
+    render_to_path(&[rest], &opts, &dir.join("rest.png")).unwrap();
+    opts.title = "two people, a wall, a target and a box".into();
+    opts.overlays = vec![
+        Overlay::Point {
+            at: Vec3::new(1.0, 1.2, 2.0),
+            label: Some("target".into()),
+        },
+        Overlay::VerticalPlane {
+            point: Vec3::new(0.0, 0.0, 4.2),
+            normal: Vec3::new(0.2, 0.0, 1.0),
+        },
+        Overlay::Box {
+            min: Vec3::new(-0.8, 0.0, 1.0),
+            max: Vec3::new(-0.2, 0.6, 1.6),
+        },
+        Overlay::HorizontalPlane { height: 1.9 },
+        Overlay::Segment {
+            from: Vec3::new(0.5, 0.0, 0.0),
+            to: Vec3::new(0.5, 1.0, 0.0),
+        },
+    ];
+    let pair = [diagonal, other];
+    render_to_path(&pair, &opts, &dir.join("pair.gif")).unwrap();
+    render_to_path(&pair, &opts, &dir.join("pair.png")).unwrap();
+    for name in ["walk", "rest", "pair"] {
+        let g = decode_gif(&dir.join(format!("{name}.gif")));
+        for k in [0, g.frames.len() / 2, g.frames.len() - 1] {
+            let png = super::encode::encode_png(&g.frames[k], g.w as u32, g.h as u32).unwrap();
+            crate::fsutil::write_bytes_atomic(&dir.join(format!("{name}-gif-{k}.png")), &png)
+                .unwrap();
+        }
+    }
+    let loss = Series {
+        name: "train".into(),
+        points: (1..500)
+            .map(|i| (i as f32, 3.0 / (i as f32).sqrt() + 0.01))
+            .collect(),
+    };
+    let val = Series {
+        name: "val".into(),
+        points: (1..25)
+            .map(|i| ((i * 20) as f32, 3.2 / ((i * 20) as f32).sqrt() + 0.02))
+            .collect(),
+    };
+    plot_lines(
+        &dir.join("loss-log.png"),
+        "training loss",
+        "step",
+        "loss",
+        &[loss.clone(), val.clone()],
+        &PlotOptions {
+            log_y: true,
+            ..PlotOptions::default()
+        },
+    )
+    .unwrap();
+    plot_lines(
+        &dir.join("loss-lin.png"),
+        "training loss",
+        "step",
+        "loss",
+        &[loss, val],
+        &PlotOptions::default(),
+    )
+    .unwrap();
 }
