@@ -24,6 +24,12 @@ where
         buf.flush()?;
     }
     tmp.as_file().sync_all()?;
+    // tempfile creates 0600 files; outputs are ordinary files that others may read.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o644))?;
+    }
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
 }

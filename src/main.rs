@@ -16,6 +16,10 @@ struct Cli {
 enum Command {
     /// Print the joint names and aliases of the skeleton.
     Joints,
+    /// Convert a motion file to other formats (by extension: bvh, npy, json, gif, png).
+    Convert(cli::convert::ConvertArgs),
+    /// Render a motion file as an animated GIF or a PNG strip.
+    Render(cli::convert::RenderArgs),
     /// Build a training set from BVH files.
     #[command(subcommand)]
     Data(cli::data::DataCommand),
@@ -31,6 +35,8 @@ fn main() -> miette::Result<()> {
     match cli.command {
         Command::Joints => print_joints(),
         Command::Data(cmd) => cli::data::run(cmd)?,
+        Command::Convert(args) => cli::convert::convert(args)?,
+        Command::Render(args) => cli::convert::render(args)?,
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
     }

@@ -10,6 +10,8 @@ use std::path::PathBuf;
 pub enum DataCommand {
     /// Convert every BVH file under a folder into one training set.
     Build(BuildArgs),
+    /// Write one clip of a training set as a motion file or picture.
+    Show(ShowArgs),
 }
 
 /// Arguments of `mprog data build`.
@@ -30,6 +32,7 @@ pub struct BuildArgs {
 pub fn run(cmd: DataCommand) -> Result<()> {
     match cmd {
         DataCommand::Build(args) => build(args),
+        DataCommand::Show(args) => show(args),
     }
 }
 
@@ -67,4 +70,31 @@ fn build(args: BuildArgs) -> Result<()> {
         opts.mirror
     );
     Ok(())
+}
+
+/// Arguments of `mprog data show`.
+#[derive(clap::Args)]
+pub struct ShowArgs {
+    /// Training set folder.
+    #[arg(long)]
+    data: PathBuf,
+    /// Clip name (file stem, `_mirror` suffix for mirrored copies).
+    #[arg(long)]
+    clip: String,
+    /// Outputs (.gif, .png, .npy, .json, .bvh).
+    #[arg(short, long, num_args = 1.., required = true)]
+    out: Vec<PathBuf>,
+}
+
+fn show(args: ShowArgs) -> Result<()> {
+    let data = mprog::dataset::Dataset::load(&args.data).into_diagnostic()?;
+    let clip = data
+        .index
+        .clips
+        .iter()
+        .find(|c| c.name == args.clip)
+        .ok_or_else(|| miette::miette!("no clip named `{}` in {}", args.clip, args.data.display()))?;
+    let motion = mprog::motion::Motion::from_flat(data.clip_joints(clip));
+    let title = format!("{} ({:?}): {}", clip.name, clip.split, clip.captions[0]);
+    super::io::write_outputs(&args.out, &[motion], &Default::default(), &title)
 }

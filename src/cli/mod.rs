@@ -3,3 +3,5 @@
 pub mod bench;
 pub mod data;
 pub mod train;
+pub mod convert;
+pub mod io;
