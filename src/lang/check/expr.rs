@@ -56,7 +56,11 @@ impl<'a> Checker<'a> {
                 }
                 let domain = self.b.domain(Domain::At(vec![t]));
                 let inner = Cx { domain, ..cx.clone() };
-                self.expr(base, env, &inner)
+                // Joints are read lazily; read this one now, at the keyframe.
+                match self.expr(base, env, &inner) {
+                    v @ Val::Joint { .. } => self.to_num(v, base.span, &inner).map_or(Val::Error, Val::Num),
+                    v => v,
+                }
             }
             ExprKind::Unary(op, arg) => self.unary(*op, arg, e.span, env, cx),
             ExprKind::Binary(op, a, b) => self.binary(*op, a, b, e.span, env, cx),
