@@ -64,7 +64,8 @@ impl<'a> Checker<'a> {
                 return bind(&env, n, Binding::Thunk { expr: value, env: env.clone(), site: None });
             }
             Stmt::Time { kind, weight, body, span } => {
-                let Some(d) = self.time_domain(kind, *span, &env, cx) else { return env };
+                // A bad time is already reported; still check the body for more errors.
+                let d = self.time_domain(kind, *span, &env, cx).unwrap_or(0);
                 let domain = if cx.domain == 0 { d } else { self.b.domain(Domain::Intersect(cx.domain, d)) };
                 let w = self.weight(weight.as_ref(), &env, cx);
                 let inner = Scx { cx: Cx { domain, ..cx.clone() }, weight: scx.weight * w, ..scx.clone() };

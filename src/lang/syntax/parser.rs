@@ -189,7 +189,10 @@ fn syntax_hint(source: &str, at: usize) -> String {
     let rest = source.get(at..).unwrap_or("");
     let line_start = source[..at.min(source.len())].rfind('\n').map_or(0, |i| i + 1);
     let line = source[line_start..].lines().next().unwrap_or("");
-    if rest.starts_with('=') && !rest.starts_with("==") {
+    let opened = source.matches('{').count();
+    if rest.is_empty() && opened > source.matches('}').count() {
+        "a `{` is never closed; add the matching `}`".into()
+    } else if rest.starts_with('=') && !rest.starts_with("==") {
         "compare with `==`; bind names with `let name = value`".into()
     } else if rest.starts_with("&&") || rest.starts_with("||") || rest.starts_with('!') {
         "logical operators are the words `and`, `or`, `not`".into()
