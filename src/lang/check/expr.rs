@@ -34,6 +34,17 @@ fn unit_of(u: Option<UnitLit>) -> Unit {
 impl<'a> Checker<'a> {
     /// Elaborates an expression.
     pub fn expr(&mut self, e: &'a Expr, env: &Env<'a>, cx: &Cx) -> Val {
+        // Inlining is call-by-name, so a few nested functions can multiply the work; a
+        // budget keeps checking time bounded whatever the input.
+        self.work += 1;
+        if self.work > super::MAX_WORK {
+            if self.work == super::MAX_WORK + 1 {
+                self.error(cx, "mprog::too_costly", e.span, format!("checking needs more than {} steps", super::MAX_WORK))
+                    .label("expands too much")
+                    .help("functions are inlined where they are called; avoid functions that use an argument many times inside other such functions");
+            }
+            return Val::Error;
+        }
         match &e.kind {
             ExprKind::Number(v, u) => {
                 if *u == Some(UnitLit::Percent) {

@@ -34,6 +34,8 @@ use values::Cx;
 pub const MAX_OPS: usize = 20_000;
 /// Most tensor elements a program may produce per sample and evaluation.
 pub const MAX_ELEMENTS_PER_SAMPLE: usize = 20_000_000;
+/// Most expression elaborations one check may take.
+pub const MAX_WORK: usize = 1_000_000;
 /// Longest motion accepted, in frames.
 pub const MAX_LENGTH: usize = 4000;
 /// Frames the motion model generates at most.
@@ -104,6 +106,8 @@ pub(crate) struct Checker<'a> {
     pub lib_lets: HashMap<&'a str, &'a Expr>,
     /// Recursive functions (reported once; calls to them elaborate to errors).
     pub poisoned: std::collections::HashSet<&'a str>,
+    /// Expressions elaborated so far (see [`MAX_WORK`]).
+    pub work: usize,
     pub statements: Vec<crate::lang::ir::Statement>,
 }
 
@@ -185,6 +189,7 @@ pub fn module_to_ir<'a>(
         lib_fns: HashMap::new(),
         lib_lets: HashMap::new(),
         poisoned: Default::default(),
+        work: 0,
         statements: Vec::new(),
     };
     c.load_library(library);
