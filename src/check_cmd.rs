@@ -31,8 +31,13 @@ pub struct CheckArgs {
 }
 
 fn parse_override(s: &str) -> Result<(String, f64), String> {
-    let (k, v) = s.split_once('=').ok_or_else(|| format!("expected NAME=VALUE, got `{s}`"))?;
-    let v: f64 = v.trim().parse().map_err(|_| format!("`{v}` is not a number"))?;
+    let (k, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, got `{s}`"))?;
+    let v: f64 = v
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{v}` is not a number"))?;
     Ok((k.trim().to_string(), v))
 }
 
@@ -54,19 +59,33 @@ pub fn run(args: &CheckArgs) -> miette::Result<bool> {
                 "diagnostics": diags.to_json(),
             })),
             Format::Human => {
-                let text = if args.plain { diags.render_plain() } else { diags.render_fancy() };
+                let text = if args.plain {
+                    diags.render_plain()
+                } else {
+                    diags.render_fancy()
+                };
                 print!("{text}");
                 let warnings = diags.warnings().count();
                 if ok {
-                    println!("{name}: ok ({warnings} warning{})", if warnings == 1 { "" } else { "s" });
+                    println!(
+                        "{name}: ok ({warnings} warning{})",
+                        if warnings == 1 { "" } else { "s" }
+                    );
                 } else {
-                    println!("{name}: {} error(s), {warnings} warning(s)", diags.error_count());
+                    println!(
+                        "{name}: {} error(s), {warnings} warning(s)",
+                        diags.error_count()
+                    );
                 }
             }
         }
     }
     if args.format == Format::Json {
-        let out = if json.len() == 1 { json.remove(0) } else { serde_json::Value::Array(json) };
+        let out = if json.len() == 1 {
+            json.remove(0)
+        } else {
+            serde_json::Value::Array(json)
+        };
         println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
     }
     Ok(all_ok)

@@ -85,7 +85,10 @@ impl Motion {
     /// Resamples to `fps` by linear interpolation between neighbouring frames.
     pub fn resample(&self, fps: f32) -> Motion {
         if self.frames.len() < 2 || (fps - self.fps).abs() < 1e-6 {
-            return Motion { frames: self.frames.clone(), fps };
+            return Motion {
+                frames: self.frames.clone(),
+                fps,
+            };
         }
         let duration = (self.frames.len() - 1) as f32 / self.fps;
         let count = (duration * fps).floor() as usize + 1;

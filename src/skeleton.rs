@@ -83,9 +83,9 @@ pub const RAW_OFFSETS: [[f32; 3]; NUM_JOINTS] = [
 /// Every HumanML3D clip is retargeted to these lengths; measured on the golden clip 012314
 /// (constant over its frames to 3e-7 m).
 pub const BONE_LENGTHS: [f32; NUM_JOINTS] = [
-    0.0, 0.10307, 0.10988, 0.13157, 0.39362, 0.39019, 0.14319, 0.43243, 0.42564, 0.05736,
-    0.14338, 0.14942, 0.21936, 0.13749, 0.14338, 0.10304, 0.13161, 0.12298, 0.25684, 0.26309,
-    0.26601, 0.26988,
+    0.0, 0.10307, 0.10988, 0.13157, 0.39362, 0.39019, 0.14319, 0.43243, 0.42564, 0.05736, 0.14338,
+    0.14942, 0.21936, 0.13749, 0.14338, 0.10304, 0.13161, 0.12298, 0.25684, 0.26309, 0.26601,
+    0.26988,
 ];
 
 /// Height of the pelvis above the floor in HumanML3D's rest pose (metres).
@@ -179,27 +179,111 @@ pub struct Segment {
 /// PMG's bone weights for the centre of mass (ProgMoGen `get_center_of_mass`; see
 /// `reference-algorithms.md` §1.4). The head segment (12–15) is the one `fixhead` zeroes.
 pub const SEGMENTS: [Segment; 21] = [
-    Segment { a: 0, b: 1, weight: 7.5 },
-    Segment { a: 0, b: 2, weight: 7.5 },
-    Segment { a: 1, b: 4, weight: 11.255 },
-    Segment { a: 2, b: 5, weight: 11.255 },
-    Segment { a: 4, b: 7, weight: 5.05 },
-    Segment { a: 5, b: 8, weight: 5.05 },
-    Segment { a: 7, b: 10, weight: 1.38 },
-    Segment { a: 8, b: 11, weight: 1.38 },
-    Segment { a: 0, b: 3, weight: 6.0 },
-    Segment { a: 3, b: 6, weight: 6.65 },
-    Segment { a: 6, b: 9, weight: 6.5 },
-    Segment { a: 9, b: 12, weight: 3.0 },
-    Segment { a: 12, b: 15, weight: 5.0 },
-    Segment { a: 9, b: 13, weight: 3.0 },
-    Segment { a: 9, b: 14, weight: 3.0 },
-    Segment { a: 13, b: 16, weight: 3.0 },
-    Segment { a: 14, b: 17, weight: 3.0 },
-    Segment { a: 16, b: 18, weight: 3.075 },
-    Segment { a: 17, b: 19, weight: 3.075 },
-    Segment { a: 18, b: 20, weight: 2.295 },
-    Segment { a: 19, b: 21, weight: 2.295 },
+    Segment {
+        a: 0,
+        b: 1,
+        weight: 7.5,
+    },
+    Segment {
+        a: 0,
+        b: 2,
+        weight: 7.5,
+    },
+    Segment {
+        a: 1,
+        b: 4,
+        weight: 11.255,
+    },
+    Segment {
+        a: 2,
+        b: 5,
+        weight: 11.255,
+    },
+    Segment {
+        a: 4,
+        b: 7,
+        weight: 5.05,
+    },
+    Segment {
+        a: 5,
+        b: 8,
+        weight: 5.05,
+    },
+    Segment {
+        a: 7,
+        b: 10,
+        weight: 1.38,
+    },
+    Segment {
+        a: 8,
+        b: 11,
+        weight: 1.38,
+    },
+    Segment {
+        a: 0,
+        b: 3,
+        weight: 6.0,
+    },
+    Segment {
+        a: 3,
+        b: 6,
+        weight: 6.65,
+    },
+    Segment {
+        a: 6,
+        b: 9,
+        weight: 6.5,
+    },
+    Segment {
+        a: 9,
+        b: 12,
+        weight: 3.0,
+    },
+    Segment {
+        a: 12,
+        b: 15,
+        weight: 5.0,
+    },
+    Segment {
+        a: 9,
+        b: 13,
+        weight: 3.0,
+    },
+    Segment {
+        a: 9,
+        b: 14,
+        weight: 3.0,
+    },
+    Segment {
+        a: 13,
+        b: 16,
+        weight: 3.0,
+    },
+    Segment {
+        a: 14,
+        b: 17,
+        weight: 3.0,
+    },
+    Segment {
+        a: 16,
+        b: 18,
+        weight: 3.075,
+    },
+    Segment {
+        a: 17,
+        b: 19,
+        weight: 3.075,
+    },
+    Segment {
+        a: 18,
+        b: 20,
+        weight: 2.295,
+    },
+    Segment {
+        a: 19,
+        b: 21,
+        weight: 2.295,
+    },
 ];
 
 /// Per-joint weights equivalent to [`SEGMENTS`]: the centre of mass is
@@ -208,7 +292,11 @@ pub const SEGMENTS: [Segment; 21] = [
 pub fn joint_mass_weights(include_head: bool) -> [f32; NUM_JOINTS] {
     let mut w = [0.0f32; NUM_JOINTS];
     for s in SEGMENTS {
-        let m = if !include_head && s.a == 12 && s.b == 15 { 0.0 } else { s.weight };
+        let m = if !include_head && s.a == 12 && s.b == 15 {
+            0.0
+        } else {
+            s.weight
+        };
         w[s.a] += 0.5 * m;
         w[s.b] += 0.5 * m;
     }

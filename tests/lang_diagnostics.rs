@@ -44,7 +44,11 @@ fn json_form_has_positions_and_hints() {
 fn overrides_are_checked() {
     let src = "length 4s\nparam diameter = 40 cm\nalways { dist(l_hand, r_hand) == diameter }\n";
     let ok = mprog::lang::compile(src, "x.mprog", &[("diameter".into(), 50.0)]).unwrap();
-    assert!((ok.params()[0].value[0] - 0.5).abs() < 1e-12, "override is in the default's unit");
+    assert!(
+        (ok.params()[0].value[0] - 0.5).abs() < 1e-12,
+        "override is in the default's unit"
+    );
     let bad = check_source(src, "x.mprog", &[("diamter".into(), 0.5)]);
-    assert!(bad.items.iter().any(|d| d.code == "mprog::unknown_param" && d.help.as_deref() == Some("did you mean `diameter`?")));
+    assert!(bad.items.iter().any(|d| d.code == "mprog::unknown_param"
+        && d.help.as_deref() == Some("did you mean `diameter`?")));
 }

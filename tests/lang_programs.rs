@@ -15,7 +15,12 @@ fn programs() -> Vec<(String, String)> {
         .unwrap()
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "mprog"))
-        .map(|p| (p.file_name().unwrap().to_string_lossy().to_string(), std::fs::read_to_string(&p).unwrap()))
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().to_string(),
+                std::fs::read_to_string(&p).unwrap(),
+            )
+        })
         .collect();
     out.sort();
     out
@@ -24,21 +29,38 @@ fn programs() -> Vec<(String, String)> {
 #[test]
 fn every_program_checks_and_evaluates() {
     let all = programs();
-    assert!(all.len() >= 19, "expected the PMG, Fig. 1 and InterControl programs");
+    assert!(
+        all.len() >= 19,
+        "expected the PMG, Fig. 1 and InterControl programs"
+    );
     for (name, src) in all {
         let prog = match compile(&src, &name, &[]) {
             Ok(p) => p,
             Err(d) => panic!("{name} does not check:\n{}", d.render_plain()),
         };
-        assert_eq!(prog.warnings().items.len(), 0, "{name}:\n{}", prog.warnings().render_plain());
+        assert_eq!(
+            prog.warnings().items.len(),
+            0,
+            "{name}:\n{}",
+            prog.warnings().render_plain()
+        );
         assert!(!prog.statements().is_empty());
         let m = motion(prog.people().len(), prog.length());
         let (data, shape) = flat(&m);
         let (total, per) = eval(&prog, &data, shape);
-        assert!(total.is_finite() && per.iter().all(|v| v.is_finite()), "{name}: {total} {per:?}");
+        assert!(
+            total.is_finite() && per.iter().all(|v| v.is_finite()),
+            "{name}: {total} {per:?}"
+        );
         let g = grad(&prog, &data, shape);
-        assert!(g.iter().all(|v| v.is_finite()), "{name}: non-finite gradient");
-        assert!(g.iter().any(|v| *v != 0.0), "{name}: zero gradient everywhere");
+        assert!(
+            g.iter().all(|v| v.is_finite()),
+            "{name}: non-finite gradient"
+        );
+        assert!(
+            g.iter().any(|v| *v != 0.0),
+            "{name}: zero gradient everywhere"
+        );
     }
 }
 
@@ -59,10 +81,19 @@ fn library_files_parse_cleanly_and_examples_compile() {
             .trim_matches('`');
         assert!(d.doc.lines().count() >= 2, "{} needs a description", d.name);
         let two = example.contains("a.") || example.contains("(a") || example.contains("a,");
-        let header = if two { "length 4s\npeople a, b\n" } else { "length 4s\n" };
+        let header = if two {
+            "length 4s\npeople a, b\n"
+        } else {
+            "length 4s\n"
+        };
         let src = format!("{header}{example}\n");
         let diags = check_source(&src, &d.name, &[]);
-        assert!(!diags.has_errors(), "example of {}:\n{}", d.name, diags.render_plain());
+        assert!(
+            !diags.has_errors(),
+            "example of {}:\n{}",
+            d.name,
+            diags.render_plain()
+        );
     }
 }
 
@@ -70,21 +101,66 @@ fn library_files_parse_cleanly_and_examples_compile() {
 fn builtin_examples_compile() {
     for b in mprog::lang::check::builtins::BUILTINS {
         let src = format!("length 4s\nalways {{ {} }}\n", b.example);
-        let src = if b.example.starts_with("minimize") { format!("length 4s\n{}\n", b.example) } else { src };
+        let src = if b.example.starts_with("minimize") {
+            format!("length 4s\n{}\n", b.example)
+        } else {
+            src
+        };
         let diags = check_source(&src, b.name, &[]);
-        assert!(!diags.has_errors(), "example of {}:\n{}", b.name, diags.render_plain());
+        assert!(
+            !diags.has_errors(),
+            "example of {}:\n{}",
+            b.name,
+            diags.render_plain()
+        );
     }
 }
 
 fn mutate(src: &str, rng: &mut rand_chacha::ChaCha8Rng) -> String {
     const PIECES: &[&str] = &[
-        "(", ")", "{", "}", "[", "]", ",", "@", ".", "..", "-", "not ", "and ", "==", "<", "%", "s", "m",
-        "end", "head", "a.", "for j in joints ", "if ", "at ", "weight ", "def f(x) = f(x)\n", "\n",
-        "1e308", "0", "/", "let x = x\n", "people a, b\n", "length 0 frames\n", "é", "\"",
+        "(",
+        ")",
+        "{",
+        "}",
+        "[",
+        "]",
+        ",",
+        "@",
+        ".",
+        "..",
+        "-",
+        "not ",
+        "and ",
+        "==",
+        "<",
+        "%",
+        "s",
+        "m",
+        "end",
+        "head",
+        "a.",
+        "for j in joints ",
+        "if ",
+        "at ",
+        "weight ",
+        "def f(x) = f(x)\n",
+        "\n",
+        "1e308",
+        "0",
+        "/",
+        "let x = x\n",
+        "people a, b\n",
+        "length 0 frames\n",
+        "é",
+        "\"",
     ];
     let mut s: Vec<char> = src.chars().collect();
     for _ in 0..rng.random_range(1..4) {
-        let at = if s.is_empty() { 0 } else { rng.random_range(0..=s.len()) };
+        let at = if s.is_empty() {
+            0
+        } else {
+            rng.random_range(0..=s.len())
+        };
         match rng.random_range(0..4) {
             0 if at < s.len() => {
                 let end = (at + rng.random_range(1..8)).min(s.len());
@@ -110,7 +186,11 @@ fn mutate(src: &str, rng: &mut rand_chacha::ChaCha8Rng) -> String {
 fn mutated_programs_never_panic() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     let mut sources: Vec<String> = programs().into_iter().map(|(_, s)| s).collect();
-    sources.extend(stdlib::FILES.iter().map(|(_, t)| format!("length 2s\n{t}\nalways {{ head.y > 1 m }}\n")));
+    sources.extend(
+        stdlib::FILES
+            .iter()
+            .map(|(_, t)| format!("length 2s\n{t}\nalways {{ head.y > 1 m }}\n")),
+    );
     let mut compiled = 0;
     for round in 0..60 {
         for src in &sources {
@@ -132,7 +212,10 @@ fn mutated_programs_never_panic() {
             }
         }
     }
-    assert!(compiled > 50, "mutations should sometimes still compile ({compiled})");
+    assert!(
+        compiled > 50,
+        "mutations should sometimes still compile ({compiled})"
+    );
 }
 
 #[test]
@@ -155,7 +238,13 @@ fn adversarial_inputs_are_diagnosed() {
     ];
     for src in &cases {
         let result = std::panic::catch_unwind(|| check_source(src, "adversarial.mprog", &[]));
-        let diags = result.unwrap_or_else(|_| panic!("panicked on input starting {:?}", &src[..src.len().min(80)]));
-        assert!(diags.has_errors(), "expected a diagnostic for input starting {:?}", &src[..src.len().min(80)]);
+        let diags = result.unwrap_or_else(|_| {
+            panic!("panicked on input starting {:?}", &src[..src.len().min(80)])
+        });
+        assert!(
+            diags.has_errors(),
+            "expected a diagnostic for input starting {:?}",
+            &src[..src.len().min(80)]
+        );
     }
 }

@@ -50,7 +50,10 @@ impl Diagnostic {
 
     /// A warning at `span`.
     pub fn warning(code: &'static str, span: Span, message: impl Into<String>) -> Self {
-        Diagnostic { severity: Severity::Warning, ..Diagnostic::error(code, span, message) }
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Diagnostic::error(code, span, message)
+        }
     }
 
     /// Sets the label shown under the span.
@@ -116,7 +119,11 @@ impl Diagnostics {
     pub fn new(name: &str, source: Arc<String>, mut items: Vec<Diagnostic>) -> Self {
         items.sort_by_key(|d| (d.span.start, d.severity != Severity::Error, d.span.end));
         items.dedup_by(|a, b| a.code == b.code && a.span == b.span && a.message == b.message);
-        Diagnostics { name: name.to_string(), source, items }
+        Diagnostics {
+            name: name.to_string(),
+            source,
+            items,
+        }
     }
 
     /// True when at least one item is an error.
@@ -126,12 +133,17 @@ impl Diagnostics {
 
     /// Number of errors.
     pub fn error_count(&self) -> usize {
-        self.items.iter().filter(|d| d.severity == Severity::Error).count()
+        self.items
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .count()
     }
 
     /// Only the warnings.
     pub fn warnings(&self) -> impl Iterator<Item = &Diagnostic> {
-        self.items.iter().filter(|d| d.severity == Severity::Warning)
+        self.items
+            .iter()
+            .filter(|d| d.severity == Severity::Warning)
     }
 
     /// 1-based (line, column) of a byte offset.
@@ -146,7 +158,11 @@ impl Diagnostics {
             .map(|d| {
                 let (line, column) = self.line_col(d.span.start);
                 let (end_line, end_column) = self.line_col(d.span.end);
-                let snippet = self.source.get(d.span.start..d.span.end).unwrap_or("").to_string();
+                let snippet = self
+                    .source
+                    .get(d.span.start..d.span.end)
+                    .unwrap_or("")
+                    .to_string();
                 JsonDiagnostic {
                     code: d.code,
                     severity: d.severity,
@@ -165,11 +181,17 @@ impl Diagnostics {
 
     /// Renders every item with the given miette theme, one report after another.
     pub fn render(&self, theme: GraphicalTheme) -> String {
-        let handler = GraphicalReportHandler::new_themed(theme).with_width(100).with_links(false);
+        let handler = GraphicalReportHandler::new_themed(theme)
+            .with_width(100)
+            .with_links(false);
         let source = Arc::new(NamedSource::new(self.name.clone(), self.source.to_string()));
         let mut out = String::new();
         for item in &self.items {
-            let report = Report { item, source: source.clone(), len: self.source.len() };
+            let report = Report {
+                item,
+                source: source.clone(),
+                len: self.source.len(),
+            };
             // Writing into a String cannot fail.
             let _ = handler.render_report(&mut out, &report);
         }
@@ -239,7 +261,10 @@ impl miette::Diagnostic for Report<'_> {
     }
 
     fn help<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
-        self.item.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display>)
+        self.item
+            .help
+            .as_ref()
+            .map(|h| Box::new(h) as Box<dyn fmt::Display>)
     }
 
     fn source_code(&self) -> Option<&dyn SourceCode> {
@@ -250,7 +275,11 @@ impl miette::Diagnostic for Report<'_> {
         let start = self.item.span.start.min(self.len);
         let end = self.item.span.end.clamp(start, self.len);
         let label = (!self.item.label.is_empty()).then(|| self.item.label.clone());
-        Some(Box::new(std::iter::once(LabeledSpan::new(label, start, end - start))))
+        Some(Box::new(std::iter::once(LabeledSpan::new(
+            label,
+            start,
+            end - start,
+        ))))
     }
 }
 
@@ -272,7 +301,10 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 }
 
 /// The closest candidate to `name`, if it is close enough to be a likely typo.
-pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+pub fn did_you_mean<'a>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
     let lower = name.to_ascii_lowercase();
     let limit = (name.chars().count() / 3).max(1) + 1;
     candidates
@@ -296,7 +328,10 @@ mod tests {
 
     #[test]
     fn did_you_mean_picks_close_names() {
-        assert_eq!(did_you_mean("r_hnad", ["r_hand", "l_hand", "head"]), Some("r_hand"));
+        assert_eq!(
+            did_you_mean("r_hnad", ["r_hand", "l_hand", "head"]),
+            Some("r_hand")
+        );
         assert_eq!(did_you_mean("zzzzzz", ["r_hand", "head"]), None);
     }
 

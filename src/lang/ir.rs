@@ -109,9 +109,16 @@ pub enum Op {
     /// A constant `[1, 1, 1, len]`.
     Const(Vec<f32>),
     /// Joint positions `[B, |D|, K, 3]`: lane k reads `(person, joint)` = `points[k]`.
-    Gather { domain: DomainId, points: Vec<(usize, usize)> },
+    Gather {
+        domain: DomainId,
+        points: Vec<(usize, usize)>,
+    },
     /// Weighted sum over all 22 joints of each lane's person `[B, |D|, K, 3]`.
-    MassCenter { domain: DomainId, persons: Vec<usize>, weights: Vec<f32> },
+    MassCenter {
+        domain: DomainId,
+        persons: Vec<usize>,
+        weights: Vec<f32>,
+    },
     /// Channel `axis` of a vector.
     Component { arg: NodeId, axis: usize },
     /// Three scalars stacked into a vector.
@@ -262,7 +269,10 @@ impl Ir {
             }
             Domain::Intersect(a, b) => {
                 let inner = self.resolve_domain(*b, f);
-                self.resolve_domain(*a, f).into_iter().filter(|t| inner.contains(t)).collect()
+                self.resolve_domain(*a, f)
+                    .into_iter()
+                    .filter(|t| inner.contains(t))
+                    .collect()
             }
             Domain::Shift(base, shift) => self
                 .resolve_domain(*base, f)
@@ -311,6 +321,9 @@ impl Ir {
             ops += if s.mask.is_some() { 6 } else { 3 };
             elements = elements.saturating_add(len_of(s.domain) * s.lanes * 2);
         }
-        CostEstimate { ops: ops + 2, elements_per_sample: elements }
+        CostEstimate {
+            ops: ops + 2,
+            elements_per_sample: elements,
+        }
     }
 }

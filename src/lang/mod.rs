@@ -62,11 +62,19 @@ pub fn check_source(source: &str, name: &str, overrides: &[(String, f64)]) -> Di
 
 /// Parses, checks and lowers a program. `overrides` replace `param` defaults (values in the
 /// unit the default was written in). Errors come back as [`Diagnostics`].
-pub fn compile(source: &str, name: &str, overrides: &[(String, f64)]) -> Result<Program, Diagnostics> {
+pub fn compile(
+    source: &str,
+    name: &str,
+    overrides: &[(String, f64)],
+) -> Result<Program, Diagnostics> {
     compile_inner(source, name, overrides)
 }
 
-fn compile_inner(source: &str, name: &str, overrides: &[(String, f64)]) -> Result<Program, Diagnostics> {
+fn compile_inner(
+    source: &str,
+    name: &str,
+    overrides: &[(String, f64)],
+) -> Result<Program, Diagnostics> {
     let text = Arc::new(source.to_string());
     let (module, mut diags) = syntax::source_to_ast(source);
     if diags.iter().any(|d| d.severity == Severity::Error) {
@@ -133,7 +141,10 @@ impl Program {
     /// One prompt per person (the person's own, else the program's).
     pub fn prompts(&self) -> Vec<Option<String>> {
         let h = &self.checked.header;
-        h.people.iter().map(|p| p.prompt.clone().or_else(|| h.prompt.clone())).collect()
+        h.people
+            .iter()
+            .map(|p| p.prompt.clone().or_else(|| h.prompt.clone()))
+            .collect()
     }
 
     /// Length in frames (20 fps).

@@ -7,14 +7,23 @@ use std::sync::LazyLock;
 
 /// The library files: (path, text).
 pub const FILES: &[(&str, &str)] = &[
-    ("stdlib/geometry.mprog", include_str!("../../stdlib/geometry.mprog")),
+    (
+        "stdlib/geometry.mprog",
+        include_str!("../../stdlib/geometry.mprog"),
+    ),
     ("stdlib/body.mprog", include_str!("../../stdlib/body.mprog")),
-    ("stdlib/people.mprog", include_str!("../../stdlib/people.mprog")),
+    (
+        "stdlib/people.mprog",
+        include_str!("../../stdlib/people.mprog"),
+    ),
 ];
 
 static LIBRARY: LazyLock<Vec<Module>> = LazyLock::new(|| {
     // A file that does not parse contributes nothing; `tests` in this crate check them all.
-    FILES.iter().map(|(_, text)| source_to_ast(text).0).collect()
+    FILES
+        .iter()
+        .map(|(_, text)| source_to_ast(text).0)
+        .collect()
 });
 
 /// The parsed library modules.
@@ -52,7 +61,12 @@ pub fn docs() -> Vec<LibDoc> {
                 }
                 Item::Stmt(Stmt::Let { name, span, .. }) => {
                     let doc = doc_lines_above(text, span.start);
-                    out.push(LibDoc { name: name.name.clone(), signature: name.name.clone(), doc, file });
+                    out.push(LibDoc {
+                        name: name.name.clone(),
+                        signature: name.name.clone(),
+                        doc,
+                        file,
+                    });
                 }
                 _ => {}
             }
@@ -66,7 +80,11 @@ fn doc_lines_above(text: &str, at: usize) -> String {
         .lines()
         .rev()
         .skip(usize::from(!text[..at].ends_with('\n')))
-        .map_while(|l| l.trim_start().strip_prefix("##").map(|d| d.strip_prefix(' ').unwrap_or(d)))
+        .map_while(|l| {
+            l.trim_start()
+                .strip_prefix("##")
+                .map(|d| d.strip_prefix(' ').unwrap_or(d))
+        })
         .collect();
     lines.reverse();
     lines.join("\n")

@@ -42,7 +42,10 @@ pub fn flat(m: &Motion) -> (Vec<f32>, [usize; 5]) {
     let frames = m[0].len();
     let data = m
         .iter()
-        .flat_map(|p| p.iter().flat_map(|f| f.iter().flat_map(|v| v.map(|x| x as f32))))
+        .flat_map(|p| {
+            p.iter()
+                .flat_map(|f| f.iter().flat_map(|v| v.map(|x| x as f32)))
+        })
         .collect();
     (data, [1, people, frames, NUM_JOINTS, 3])
 }
@@ -60,8 +63,8 @@ pub fn eval(p: &Program, data: &[f32], shape: [usize; 5]) -> (f64, Vec<f64>) {
     let dev = Device::flex();
     let x = Tensor::<5>::from_data(TensorData::new(data.to_vec(), shape), &dev);
     let e = p.evaluate(x);
-    let total = e.total.into_data().into_vec::<f32>().unwrap()[0] as f64;
-    let per = e.per_statement.into_data().into_vec::<f32>().unwrap();
+    let total = e.total.into_data().try_into_vec::<f32>().unwrap()[0] as f64;
+    let per = e.per_statement.into_data().try_into_vec::<f32>().unwrap();
     (total, per.into_iter().map(f64::from).collect())
 }
 
@@ -71,7 +74,11 @@ pub fn grad(p: &Program, data: &[f32], shape: [usize; 5]) -> Vec<f32> {
     let x = Tensor::<5>::from_data(TensorData::new(data.to_vec(), shape), &dev).require_grad();
     let e = p.evaluate(x.clone());
     let g = e.total.sum().backward();
-    x.grad(&g).expect("joints get a gradient").into_data().into_vec::<f32>().unwrap()
+    x.grad(&g)
+        .expect("joints get a gradient")
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap()
 }
 
 /// Compares the autodiff gradient with central differences on its largest entries and a
@@ -79,7 +86,10 @@ pub fn grad(p: &Program, data: &[f32], shape: [usize; 5]) -> Vec<f32> {
 pub fn check_gradient(p: &Program, m: &Motion, what: &str) {
     let (data, shape) = flat(m);
     let g = grad(p, &data, shape);
-    assert!(g.iter().all(|v| v.is_finite()), "{what}: non-finite gradient");
+    assert!(
+        g.iter().all(|v| v.is_finite()),
+        "{what}: non-finite gradient"
+    );
     let mut order: Vec<usize> = (0..g.len()).collect();
     order.sort_by(|&a, &b| g[b].abs().total_cmp(&g[a].abs()));
     let mut picks: Vec<usize> = order.iter().take(6).copied().collect();
@@ -93,7 +103,10 @@ pub fn check_gradient(p: &Program, m: &Motion, what: &str) {
         let fd = (eval(p, &plus, shape).0 - eval(p, &minus, shape).0) / (2.0 * f64::from(h));
         let an = f64::from(g[i]);
         let tol = 5e-3 + 2e-2 * an.abs().max(fd.abs());
-        assert!((an - fd).abs() <= tol, "{what}: d/dx[{i}] autodiff {an} vs finite difference {fd}");
+        assert!(
+            (an - fd).abs() <= tol,
+            "{what}: d/dx[{i}] autodiff {an} vs finite difference {fd}"
+        );
     }
 }
 
@@ -114,7 +127,11 @@ pub fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 pub fn relu(x: f64) -> f64 {
     x.max(0.0)

@@ -46,7 +46,10 @@ impl Builder {
     }
 
     fn push(&mut self, node: Node) -> NodeId {
-        let key = format!("{:?}|{:?}|{}|{}", node.op, node.frames, node.lanes, node.channels);
+        let key = format!(
+            "{:?}|{:?}|{}|{}",
+            node.op, node.frames, node.lanes, node.channels
+        );
         if let Some(&id) = self.cse.get(&key) {
             return id;
         }
@@ -104,7 +107,11 @@ impl Builder {
     ) -> NodeId {
         let lanes = persons.len();
         self.push(Node {
-            op: Op::MassCenter { domain, persons, weights },
+            op: Op::MassCenter {
+                domain,
+                persons,
+                weights,
+            },
             span,
             frames: Frames::Domain(domain),
             lanes,
@@ -132,7 +139,14 @@ impl Builder {
             lanes = lanes.max(n.lanes);
             motion |= n.motion;
         }
-        self.push(Node { op, span, frames, lanes, channels, motion })
+        self.push(Node {
+            op,
+            span,
+            frames,
+            lanes,
+            channels,
+            motion,
+        })
     }
 
     /// Channel `axis` of `arg`.
@@ -146,9 +160,11 @@ impl Builder {
 
     /// A vector from three scalars.
     pub fn compose(&mut self, xyz: [NodeId; 3], span: Span) -> NodeId {
-        if let (Some(x), Some(y), Some(z)) =
-            (self.const_of(xyz[0]), self.const_of(xyz[1]), self.const_of(xyz[2]))
-        {
+        if let (Some(x), Some(y), Some(z)) = (
+            self.const_of(xyz[0]),
+            self.const_of(xyz[1]),
+            self.const_of(xyz[2]),
+        ) {
             let v = [f64::from(x[0]), f64::from(y[0]), f64::from(z[0])];
             return self.konst(&v, span);
         }
@@ -187,7 +203,9 @@ impl Builder {
             BinaryOp::Add if is(b, 0.0, self) && self.nodes[a].channels == channels => return a,
             BinaryOp::Add if is(a, 0.0, self) && self.nodes[b].channels == channels => return b,
             BinaryOp::Sub if is(b, 0.0, self) && self.nodes[a].channels == channels => return a,
-            BinaryOp::Mul | BinaryOp::Div if is(b, 1.0, self) && self.nodes[a].channels == channels => {
+            BinaryOp::Mul | BinaryOp::Div
+                if is(b, 1.0, self) && self.nodes[a].channels == channels =>
+            {
                 return a;
             }
             BinaryOp::Mul if is(a, 1.0, self) && self.nodes[b].channels == channels => return b,
@@ -220,9 +238,15 @@ impl Builder {
     /// Cross product.
     pub fn cross(&mut self, a: NodeId, b: NodeId, span: Span) -> NodeId {
         if let (Some(x), Some(y)) = (self.const_of(a), self.const_of(b)) {
-            let (x, y): (Vec<f64>, Vec<f64>) =
-                (x.iter().map(|&v| v.into()).collect(), y.iter().map(|&v| v.into()).collect());
-            let c = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+            let (x, y): (Vec<f64>, Vec<f64>) = (
+                x.iter().map(|&v| v.into()).collect(),
+                y.iter().map(|&v| v.into()).collect(),
+            );
+            let c = [
+                x[1] * y[2] - x[2] * y[1],
+                x[2] * y[0] - x[0] * y[2],
+                x[0] * y[1] - x[1] * y[0],
+            ];
             return self.konst(&c, span);
         }
         self.node_like(Op::Cross(a, b), span, &[a, b], 3)
@@ -246,7 +270,13 @@ impl Builder {
     }
 
     /// Support-polygon distance.
-    pub fn support_dist(&mut self, point: NodeId, feet: NodeId, lanes: usize, span: Span) -> NodeId {
+    pub fn support_dist(
+        &mut self,
+        point: NodeId,
+        feet: NodeId,
+        lanes: usize,
+        span: Span,
+    ) -> NodeId {
         let frames = self.merge_frames(self.nodes[point].frames, self.nodes[feet].frames);
         self.push(Node {
             op: Op::SupportDist { point, feet },

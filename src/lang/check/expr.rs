@@ -48,28 +48,44 @@ impl<'a> Checker<'a> {
         match &e.kind {
             ExprKind::Number(v, u) => {
                 if *u == Some(UnitLit::Percent) {
-                    self.error(cx, "mprog::misplaced_percent", e.span, "`%` is only meaningful as a time position")
-                        .label("percent of the motion")
-                        .help("use it in `at 50% { … }`, `during 0%..25% { … }` or `head@50%`");
+                    self.error(
+                        cx,
+                        "mprog::misplaced_percent",
+                        e.span,
+                        "`%` is only meaningful as a time position",
+                    )
+                    .label("percent of the motion")
+                    .help("use it in `at 50% { … }`, `during 0%..25% { … }` or `head@50%`");
                     return Val::Error;
                 }
                 let node = self.b.konst(&[v * u.map_or(1.0, unit_scale)], e.span);
-                Val::Num(Num { node, unit: unit_of(*u), vector: false })
+                Val::Num(Num {
+                    node,
+                    unit: unit_of(*u),
+                    vector: false,
+                })
             }
             ExprKind::Name(n) => self.name(n, e.span, env, cx),
             ExprKind::List(items) => self.list(items, e.span, env, cx),
             ExprKind::Call(name, args) => self.call(name, args, e.span, env, cx),
             ExprKind::Member(base, field) => self.member(base, field, env, cx),
             ExprKind::At(base, time) => {
-                let Some(t) = self.time_point(time, env, cx) else { return Val::Error };
+                let Some(t) = self.time_point(time, env, cx) else {
+                    return Val::Error;
+                };
                 if !self.check_time(t, time.span, cx) {
                     return Val::Error;
                 }
                 let domain = self.b.domain(Domain::At(vec![t]));
-                let inner = Cx { domain, ..cx.clone() };
+                let inner = Cx {
+                    domain,
+                    ..cx.clone()
+                };
                 // Joints are read lazily; read this one now, at the keyframe.
                 match self.expr(base, env, &inner) {
-                    v @ Val::Joint { .. } => self.to_num(v, base.span, &inner).map_or(Val::Error, Val::Num),
+                    v @ Val::Joint { .. } => self
+                        .num_of(v, base.span, &inner)
+                        .map_or(Val::Error, Val::Num),
                     v => v,
                 }
             }
@@ -82,40 +98,68 @@ impl<'a> Checker<'a> {
     /// Elaborates an expression that must be a number, vector or joint (as a point).
     pub fn num(&mut self, e: &'a Expr, env: &Env<'a>, cx: &Cx) -> Option<Num> {
         let v = self.expr(e, env, cx);
-        self.to_num(v, e.span, cx)
+        self.num_of(v, e.span, cx)
     }
 
     /// A value as a number: joints become their positions.
-    pub fn to_num(&mut self, v: Val, span: Span, cx: &Cx) -> Option<Num> {
+    pub fn num_of(&mut self, v: Val, span: Span, cx: &Cx) -> Option<Num> {
         match v {
             Val::Num(n) => Some(n),
-            Val::Joint { person: Some(p), joint } => {
+            Val::Joint {
+                person: Some(p),
+                joint,
+            } => {
                 let points = if p.is_one() && joint.is_one() {
                     vec![(p.get(0), joint.get(0))]
                 } else {
                     (0..cx.lanes).map(|l| (p.get(l), joint.get(l))).collect()
                 };
                 let node = self.b.gather(cx.domain, points, span);
-                Some(Num { node, unit: Unit::M, vector: true })
+                Some(Num {
+                    node,
+                    unit: Unit::M,
+                    vector: true,
+                })
             }
-            Val::Joint { person: None, joint } => {
+            Val::Joint {
+                person: None,
+                joint,
+            } => {
                 let name = JOINT_NAMES[joint.get(0)];
-                let first = self.header.people.first().map_or("a".to_string(), |p| p.name.clone());
-                self.error(cx, "mprog::needs_person", span, format!("whose `{name}`? this program has several people"))
-                    .label("joint without a person")
-                    .help(format!("qualify it with a person, e.g. `{first}.{name}`"));
+                let first = self
+                    .header
+                    .people
+                    .first()
+                    .map_or("a".to_string(), |p| p.name.clone());
+                self.error(
+                    cx,
+                    "mprog::needs_person",
+                    span,
+                    format!("whose `{name}`? this program has several people"),
+                )
+                .label("joint without a person")
+                .help(format!("qualify it with a person, e.g. `{first}.{name}`"));
                 None
             }
             Val::Error => None,
             other => {
                 let hint = match other {
-                    Val::Person(_) => "a person is not a point; use one of their joints, e.g. `a.pelvis`",
-                    Val::JointSet(_) | Val::PersonSet(_) => "loop over a list with `for j in [...] { … }`",
+                    Val::Person(_) => {
+                        "a person is not a point; use one of their joints, e.g. `a.pelvis`"
+                    }
+                    Val::JointSet(_) | Val::PersonSet(_) => {
+                        "loop over a list with `for j in [...] { … }`"
+                    }
                     _ => "a constraint has no value; compare numbers, e.g. `dist(a, b) < 0.1 m`",
                 };
-                self.error(cx, "mprog::type_mismatch", span, format!("expected a number or point, found {}", other.describe()))
-                    .label(other.describe())
-                    .help(hint);
+                self.error(
+                    cx,
+                    "mprog::type_mismatch",
+                    span,
+                    format!("expected a number or point, found {}", other.describe()),
+                )
+                .label(other.describe())
+                .help(hint);
                 None
             }
         }
@@ -123,7 +167,11 @@ impl<'a> Checker<'a> {
 
     fn name(&mut self, n: &str, span: Span, env: &Env<'a>, cx: &Cx) -> Val {
         match lookup(env, n) {
-            Some(Binding::Thunk { expr, env: tenv, site }) => {
+            Some(Binding::Thunk {
+                expr,
+                env: tenv,
+                site,
+            }) => {
                 let inner = Cx { site, ..cx.clone() };
                 return self.expr(expr, &tenv, &inner);
             }
@@ -132,14 +180,21 @@ impl<'a> Checker<'a> {
         }
         if let Some(p) = self.header.params.iter().find(|p| p.name == n) {
             let vector = p.value.len() == 3;
-            return Val::Num(Num { node: p.node, unit: p.unit_value, vector });
+            return Val::Num(Num {
+                node: p.node,
+                unit: p.unit_value,
+                vector,
+            });
         }
         if let Some(i) = self.header.people.iter().position(|p| p.name == n) {
             return Val::Person(LaneVec::One(i));
         }
         if let Some(j) = joint_index(n) {
             let person = (!self.multi).then_some(LaneVec::One(0));
-            return Val::Joint { person, joint: LaneVec::One(j) };
+            return Val::Joint {
+                person,
+                joint: LaneVec::One(j),
+            };
         }
         match n {
             "joints" => {
@@ -149,24 +204,40 @@ impl<'a> Checker<'a> {
             "people" => return Val::PersonSet((0..self.header.people.len()).collect()),
             "me" if !self.multi => return Val::Person(LaneVec::One(0)),
             "start" | "mid" | "end" => {
-                self.error(cx, "mprog::misplaced_time", span, format!("`{n}` is a time position, not a value"))
-                    .label("only valid as a time")
-                    .help(format!("use it in `at {n} {{ … }}` or `head@{n}`"));
+                self.error(
+                    cx,
+                    "mprog::misplaced_time",
+                    span,
+                    format!("`{n}` is a time position, not a value"),
+                )
+                .label("only valid as a time")
+                .help(format!("use it in `at {n} {{ … }}` or `head@{n}`"));
                 return Val::Error;
             }
             _ => {}
         }
         if let Some(&e) = self.lib_lets.get(n) {
-            let inner = Cx { site: cx.site.or(Some(span)), ..cx.clone() };
+            let inner = Cx {
+                site: cx.site.or(Some(span)),
+                ..cx.clone()
+            };
             return self.expr(e, &None, &inner);
         }
         if self.poisoned.contains(n) {
             return Val::Error;
         }
-        if self.user_fns.contains_key(n) || self.lib_fns.contains_key(n) || super::builtins::find(n).is_some() {
-            self.error(cx, "mprog::type_mismatch", span, format!("`{n}` is a function"))
-                .label("not called")
-                .help(format!("call it with arguments: `{n}(…)`"));
+        if self.user_fns.contains_key(n)
+            || self.lib_fns.contains_key(n)
+            || super::builtins::find(n).is_some()
+        {
+            self.error(
+                cx,
+                "mprog::type_mismatch",
+                span,
+                format!("`{n}` is a function"),
+            )
+            .label("not called")
+            .help(format!("call it with arguments: `{n}(…)`"));
             return Val::Error;
         }
         self.unknown_name(n, span, env, cx);
@@ -183,8 +254,14 @@ impl<'a> Checker<'a> {
         candidates.extend(self.lib_lets.keys().map(|k| k.to_string()));
         candidates.extend(["joints", "people"].map(String::from));
         let best = did_you_mean(n, candidates.iter().map(String::as_str)).map(str::to_string);
-        let is_joint = best.as_ref().is_some_and(|b| candidates[..joint_count].contains(b));
-        let code = if is_joint { "mprog::unknown_joint" } else { "mprog::unknown_name" };
+        let is_joint = best
+            .as_ref()
+            .is_some_and(|b| candidates[..joint_count].contains(b));
+        let code = if is_joint {
+            "mprog::unknown_joint"
+        } else {
+            "mprog::unknown_name"
+        };
         let what = if is_joint { "joint" } else { "name" };
         let help = match best {
             Some(b) => format!("did you mean `{b}`?"),
@@ -192,7 +269,9 @@ impl<'a> Checker<'a> {
                      declare values with `let` or `param`"
                 .to_string(),
         };
-        self.error(cx, code, span, format!("unknown {what} `{n}`")).label("not defined").help(help);
+        self.error(cx, code, span, format!("unknown {what} `{n}`"))
+            .label("not defined")
+            .help(help);
     }
 
     fn loop_value(&mut self, level: usize, cx: &Cx) -> Val {
@@ -231,25 +310,41 @@ impl<'a> Checker<'a> {
         if !vals.is_empty() && vals.iter().all(|v| matches!(v, Val::Joint { .. })) {
             let mut set = Vec::new();
             for (v, e) in vals.iter().zip(items) {
-                let Val::Joint { person, joint } = v else { continue };
+                let Val::Joint { person, joint } = v else {
+                    continue;
+                };
                 match (person, joint) {
                     (None, LaneVec::One(j)) => set.push((None, *j)),
                     (Some(LaneVec::One(p)), LaneVec::One(j)) => set.push((Some(*p), *j)),
                     _ => {
-                        self.error(cx, "mprog::type_mismatch", e.span, "a loop variable cannot go into a joint list")
-                            .help("list fixed joints, e.g. `[head, neck]`");
+                        self.error(
+                            cx,
+                            "mprog::type_mismatch",
+                            e.span,
+                            "a loop variable cannot go into a joint list",
+                        )
+                        .help("list fixed joints, e.g. `[head, neck]`");
                         return Val::Error;
                     }
                 }
             }
             if set.iter().any(|(p, _)| p.is_none()) && set.iter().any(|(p, _)| p.is_some()) {
-                self.error(cx, "mprog::type_mismatch", span, "mix of joints with and without a person")
-                    .help("qualify all of them (`a.head`) or none (`head`)");
+                self.error(
+                    cx,
+                    "mprog::type_mismatch",
+                    span,
+                    "mix of joints with and without a person",
+                )
+                .help("qualify all of them (`a.head`) or none (`head`)");
                 return Val::Error;
             }
             return Val::JointSet(set);
         }
-        if !vals.is_empty() && vals.iter().all(|v| matches!(v, Val::Person(LaneVec::One(_)))) {
+        if !vals.is_empty()
+            && vals
+                .iter()
+                .all(|v| matches!(v, Val::Person(LaneVec::One(_))))
+        {
             let set = vals
                 .iter()
                 .filter_map(|v| match v {
@@ -260,19 +355,29 @@ impl<'a> Checker<'a> {
             return Val::PersonSet(set);
         }
         if vals.len() != 3 {
-            self.error(cx, "mprog::bad_list", span, format!("a vector needs 3 numbers, this list has {}", vals.len()))
-                .label("not [x, y, z]")
-                .help("write a vector as `[x, y, z]`, or a list of joints such as `[l_hand, r_hand]`");
+            self.error(
+                cx,
+                "mprog::bad_list",
+                span,
+                format!("a vector needs 3 numbers, this list has {}", vals.len()),
+            )
+            .label("not [x, y, z]")
+            .help("write a vector as `[x, y, z]`, or a list of joints such as `[l_hand, r_hand]`");
             return Val::Error;
         }
         let mut nums = Vec::new();
         for (v, e) in vals.into_iter().zip(items) {
-            match self.to_num(v, e.span, cx) {
+            match self.num_of(v, e.span, cx) {
                 Some(n) if !n.vector => nums.push(n),
                 Some(_) => {
-                    self.error(cx, "mprog::type_mismatch", e.span, "a vector's entries must be scalars")
-                        .label("a vector")
-                        .help("take a component, e.g. `head.y`");
+                    self.error(
+                        cx,
+                        "mprog::type_mismatch",
+                        e.span,
+                        "a vector's entries must be scalars",
+                    )
+                    .label("a vector")
+                    .help("take a component, e.g. `head.y`");
                     return Val::Error;
                 }
                 None => return Val::Error,
@@ -283,15 +388,26 @@ impl<'a> Checker<'a> {
             match unit.unify(n.unit) {
                 Some(u) => unit = u,
                 None => {
-                    self.error(cx, "mprog::unit_mismatch", e.span, format!("vector entries mix {unit} and {}", n.unit))
-                        .label(n.unit.to_string())
-                        .help("all three entries need the same unit");
+                    self.error(
+                        cx,
+                        "mprog::unit_mismatch",
+                        e.span,
+                        format!("vector entries mix {unit} and {}", n.unit),
+                    )
+                    .label(n.unit.to_string())
+                    .help("all three entries need the same unit");
                     return Val::Error;
                 }
             }
         }
-        let node = self.b.compose([nums[0].node, nums[1].node, nums[2].node], span);
-        Val::Num(Num { node, unit, vector: true })
+        let node = self
+            .b
+            .compose([nums[0].node, nums[1].node, nums[2].node], span);
+        Val::Num(Num {
+            node,
+            unit,
+            vector: true,
+        })
     }
 
     fn member(&mut self, base: &'a Expr, field: &'a Ident, env: &Env<'a>, cx: &Cx) -> Val {
@@ -302,13 +418,20 @@ impl<'a> Checker<'a> {
         {
             let people: Vec<&str> = self.header.people.iter().map(|p| p.name.as_str()).collect();
             let help = match did_you_mean(n, people.iter().copied()) {
-                Some(s) if self.multi => format!("did you mean `{s}`? the people are: {}", people.join(", ")),
+                Some(s) if self.multi => {
+                    format!("did you mean `{s}`? the people are: {}", people.join(", "))
+                }
                 _ if self.multi => format!("the people are: {}", people.join(", ")),
                 _ => format!("this program has one person: write the joint alone, `{f}`"),
             };
-            self.error(cx, "mprog::unknown_person", base.span, format!("no person named `{n}`"))
-                .label("not declared in `people`")
-                .help(help);
+            self.error(
+                cx,
+                "mprog::unknown_person",
+                base.span,
+                format!("no person named `{n}`"),
+            )
+            .label("not declared in `people`")
+            .help(help);
             return Val::Error;
         }
         let v = self.expr(base, env, cx);
@@ -317,28 +440,49 @@ impl<'a> Checker<'a> {
             Val::Error => Val::Error,
             Val::Person(p) => {
                 if let Some(j) = joint_index(f) {
-                    return Val::Joint { person: Some(p), joint: LaneVec::One(j) };
+                    return Val::Joint {
+                        person: Some(p),
+                        joint: LaneVec::One(j),
+                    };
                 }
                 if let Some(Binding::Loop(level)) = lookup(env, f)
-                    && let Val::Joint { person: None, joint } = self.loop_value(level, cx)
+                    && let Val::Joint {
+                        person: None,
+                        joint,
+                    } = self.loop_value(level, cx)
                 {
-                    return Val::Joint { person: Some(p), joint };
+                    return Val::Joint {
+                        person: Some(p),
+                        joint,
+                    };
                 }
                 let help = match did_you_mean(f, all_joint_names()) {
                     Some(s) => format!("did you mean `{s}`?"),
                     None => "see `mprog joints` for joint names and aliases".to_string(),
                 };
-                self.error(cx, "mprog::unknown_joint", field.span, format!("unknown joint `{f}`"))
-                    .label("not a joint")
-                    .help(help);
+                self.error(
+                    cx,
+                    "mprog::unknown_joint",
+                    field.span,
+                    format!("unknown joint `{f}`"),
+                )
+                .label("not a joint")
+                .help(help);
                 Val::Error
             }
             other => {
-                let Some(n) = self.to_num(other, base.span, cx) else { return Val::Error };
+                let Some(n) = self.num_of(other, base.span, cx) else {
+                    return Val::Error;
+                };
                 if !n.vector {
-                    self.error(cx, "mprog::type_mismatch", field.span, format!("a scalar has no component `.{f}`"))
-                        .label("scalar")
-                        .help("components exist on vectors and joints, e.g. `head.y`");
+                    self.error(
+                        cx,
+                        "mprog::type_mismatch",
+                        field.span,
+                        format!("a scalar has no component `.{f}`"),
+                    )
+                    .label("scalar")
+                    .help("components exist on vectors and joints, e.g. `head.y`");
                     return Val::Error;
                 }
                 let axis = match f {
@@ -356,16 +500,26 @@ impl<'a> Checker<'a> {
                         let hint = if joint_index(f).is_some() {
                             format!("`.{f}` reads a person's joint; the left side must be a person")
                         } else {
-                            "vectors have `.x`, `.y`, `.z` and `.xz` (ground projection)".to_string()
+                            "vectors have `.x`, `.y`, `.z` and `.xz` (ground projection)"
+                                .to_string()
                         };
-                        self.error(cx, "mprog::unknown_component", field.span, format!("no component `.{f}`"))
-                            .label("not x, y, z or xz")
-                            .help(hint);
+                        self.error(
+                            cx,
+                            "mprog::unknown_component",
+                            field.span,
+                            format!("no component `.{f}`"),
+                        )
+                        .label("not x, y, z or xz")
+                        .help(hint);
                         return Val::Error;
                     }
                 };
                 let node = self.b.component(n.node, axis, span);
-                Val::Num(Num { node, unit: n.unit, vector: false })
+                Val::Num(Num {
+                    node,
+                    unit: n.unit,
+                    vector: false,
+                })
             }
         }
     }
@@ -387,25 +541,45 @@ impl<'a> Checker<'a> {
             (_, Val::Error) => Val::Error,
             (UnOp::Not, Val::Formula(f)) => Val::Formula(Rc::new(Formula::Not(f))),
             (UnOp::Not, other) => {
-                self.error(cx, "mprog::type_mismatch", arg.span, format!("`not` needs a constraint, found {}", other.describe()))
-                    .label(other.describe())
-                    .help("negate a comparison, e.g. `not (head.y < 1 m)`");
+                self.error(
+                    cx,
+                    "mprog::type_mismatch",
+                    arg.span,
+                    format!("`not` needs a constraint, found {}", other.describe()),
+                )
+                .label(other.describe())
+                .help("negate a comparison, e.g. `not (head.y < 1 m)`");
                 Val::Error
             }
             (UnOp::Neg, Val::Formula(_)) => {
-                self.error(cx, "mprog::type_mismatch", arg.span, "`-` cannot negate a constraint")
-                    .help("use `not` to ask for the opposite of a constraint");
+                self.error(
+                    cx,
+                    "mprog::type_mismatch",
+                    arg.span,
+                    "`-` cannot negate a constraint",
+                )
+                .help("use `not` to ask for the opposite of a constraint");
                 Val::Error
             }
             (UnOp::Neg, other) => {
-                let Some(n) = self.to_num(other, arg.span, cx) else { return Val::Error };
+                let Some(n) = self.num_of(other, arg.span, cx) else {
+                    return Val::Error;
+                };
                 let node = self.b.unary(UnaryOp::Neg, n.node, span);
                 Val::Num(Num { node, ..n })
             }
         }
     }
 
-    fn binary(&mut self, op: BinOp, a: &'a Expr, b: &'a Expr, span: Span, env: &Env<'a>, cx: &Cx) -> Val {
+    fn binary(
+        &mut self,
+        op: BinOp,
+        a: &'a Expr,
+        b: &'a Expr,
+        span: Span,
+        env: &Env<'a>,
+        cx: &Cx,
+    ) -> Val {
         let va = self.expr(a, env, cx);
         let vb = self.expr(b, env, cx);
         if va == Val::Error || vb == Val::Error {
@@ -419,35 +593,66 @@ impl<'a> Checker<'a> {
                     Formula::Or(x, y)
                 })),
                 (x, y) => {
-                    let (bad, e) = if matches!(x, Val::Formula(_)) { (y, b) } else { (x, a) };
-                    self.error(cx, "mprog::type_mismatch", e.span, format!("`{}` joins constraints, found {}", op.symbol(), bad.describe()))
-                        .label(bad.describe())
-                        .help("both sides must be comparisons, e.g. `head.y > 1 m and head.y < 2 m`");
+                    let (bad, e) = if matches!(x, Val::Formula(_)) {
+                        (y, b)
+                    } else {
+                        (x, a)
+                    };
+                    self.error(
+                        cx,
+                        "mprog::type_mismatch",
+                        e.span,
+                        format!(
+                            "`{}` joins constraints, found {}",
+                            op.symbol(),
+                            bad.describe()
+                        ),
+                    )
+                    .label(bad.describe())
+                    .help("both sides must be comparisons, e.g. `head.y > 1 m and head.y < 2 m`");
                     Val::Error
                 }
             };
         }
         if op.is_comparison() && (matches!(va, Val::Formula(_)) || matches!(vb, Val::Formula(_))) {
-            self.error(cx, "mprog::chained_comparison", span, "comparisons cannot be chained")
-                .label("comparison of a comparison")
-                .help("write `a < b and b < c`");
+            self.error(
+                cx,
+                "mprog::chained_comparison",
+                span,
+                "comparisons cannot be chained",
+            )
+            .label("comparison of a comparison")
+            .help("write `a < b and b < c`");
             return Val::Error;
         }
-        let (Some(x), Some(y)) = (self.to_num(va, a.span, cx), self.to_num(vb, b.span, cx)) else {
+        let (Some(x), Some(y)) = (self.num_of(va, a.span, cx), self.num_of(vb, b.span, cx)) else {
             return Val::Error;
         };
         self.arith(op, x, y, (a.span, b.span), span, cx)
     }
 
     /// Arithmetic and comparisons on two numbers (checks kinds and units).
-    pub fn arith(&mut self, op: BinOp, x: Num, y: Num, spans: (Span, Span), span: Span, cx: &Cx) -> Val {
+    pub fn arith(
+        &mut self,
+        op: BinOp,
+        x: Num,
+        y: Num,
+        spans: (Span, Span),
+        span: Span,
+        cx: &Cx,
+    ) -> Val {
         let kind = |n: &Num| if n.vector { "vector" } else { "scalar" };
         let unify = |s: &mut Self, what: &str| -> Option<Unit> {
             let u = x.unit.unify(y.unit);
             if u.is_none() {
-                s.error(cx, "mprog::unit_mismatch", span, format!("cannot {what} {} and {}", x.unit, y.unit))
-                    .label(format!("{} vs {}", x.unit, y.unit))
-                    .help(unit_hint(x.unit, y.unit));
+                s.error(
+                    cx,
+                    "mprog::unit_mismatch",
+                    span,
+                    format!("cannot {what} {} and {}", x.unit, y.unit),
+                )
+                .label(format!("{} vs {}", x.unit, y.unit))
+                .help(unit_hint(x.unit, y.unit));
             }
             u
         };
@@ -465,47 +670,93 @@ impl<'a> Checker<'a> {
                         .help("put the vector on the left (all components), or compare components such as `.y`");
                     return Val::Error;
                 }
-                let Some(unit) = unify(self, "compare") else { return Val::Error };
-                Val::Formula(Rc::new(Formula::Cmp { op, a: x.node, b: y.node, unit, span }))
+                let Some(unit) = unify(self, "compare") else {
+                    return Val::Error;
+                };
+                Val::Formula(Rc::new(Formula::Cmp {
+                    op,
+                    a: x.node,
+                    b: y.node,
+                    unit,
+                    span,
+                }))
             }
             BinOp::Add | BinOp::Sub => {
                 if x.vector != y.vector {
-                    self.error(cx, "mprog::type_mismatch", span, format!("cannot {} a {} and a {}", if op == BinOp::Add { "add" } else { "subtract" }, kind(&x), kind(&y)))
-                        .label("different kinds")
-                        .help("vectors combine with vectors; use `[x, y, z]` or a component like `.y`");
+                    self.error(
+                        cx,
+                        "mprog::type_mismatch",
+                        span,
+                        format!(
+                            "cannot {} a {} and a {}",
+                            if op == BinOp::Add { "add" } else { "subtract" },
+                            kind(&x),
+                            kind(&y)
+                        ),
+                    )
+                    .label("different kinds")
+                    .help("vectors combine with vectors; use `[x, y, z]` or a component like `.y`");
                     return Val::Error;
                 }
                 let verb = if op == BinOp::Add { "add" } else { "subtract" };
-                let Some(unit) = unify(self, verb) else { return Val::Error };
-                let bop = if op == BinOp::Add { BinaryOp::Add } else { BinaryOp::Sub };
+                let Some(unit) = unify(self, verb) else {
+                    return Val::Error;
+                };
+                let bop = if op == BinOp::Add {
+                    BinaryOp::Add
+                } else {
+                    BinaryOp::Sub
+                };
                 let node = self.b.binary(bop, x.node, y.node, span);
-                Val::Num(Num { node, unit, vector: x.vector })
+                Val::Num(Num {
+                    node,
+                    unit,
+                    vector: x.vector,
+                })
             }
             BinOp::Mul => {
                 if x.vector && y.vector {
-                    self.error(cx, "mprog::type_mismatch", span, "cannot multiply two vectors")
-                        .label("vector * vector")
-                        .help("use `dot(u, v)` or `cross(u, v)`");
+                    self.error(
+                        cx,
+                        "mprog::type_mismatch",
+                        span,
+                        "cannot multiply two vectors",
+                    )
+                    .label("vector * vector")
+                    .help("use `dot(u, v)` or `cross(u, v)`");
                     return Val::Error;
                 }
                 let node = self.b.binary(BinaryOp::Mul, x.node, y.node, span);
-                Val::Num(Num { node, unit: x.unit.mul(y.unit), vector: x.vector || y.vector })
+                Val::Num(Num {
+                    node,
+                    unit: x.unit.times(y.unit),
+                    vector: x.vector || y.vector,
+                })
             }
             BinOp::Div => {
                 if y.vector {
-                    self.error(cx, "mprog::type_mismatch", spans.1, "cannot divide by a vector")
-                        .label("vector")
-                        .help("divide by a scalar, e.g. `norm(v)`");
+                    self.error(
+                        cx,
+                        "mprog::type_mismatch",
+                        spans.1,
+                        "cannot divide by a vector",
+                    )
+                    .label("vector")
+                    .help("divide by a scalar, e.g. `norm(v)`");
                     return Val::Error;
                 }
-                if self.b.const_of(y.node).is_some_and(|v| v.iter().any(|&c| c == 0.0)) {
+                if self.b.const_of(y.node).is_some_and(|v| v.contains(&0.0)) {
                     self.error(cx, "mprog::division_by_zero", spans.1, "division by zero")
                         .label("is 0")
                         .help("divide by a non-zero constant");
                     return Val::Error;
                 }
                 let node = self.b.binary(BinaryOp::Div, x.node, y.node, span);
-                Val::Num(Num { node, unit: x.unit.div(y.unit), vector: x.vector })
+                Val::Num(Num {
+                    node,
+                    unit: x.unit.per(y.unit),
+                    vector: x.vector,
+                })
             }
             BinOp::And | BinOp::Or => Val::Error,
         }
@@ -521,6 +772,8 @@ pub fn unit_hint(a: Unit, b: Unit) -> String {
     } else if a == Unit::RAD || b == Unit::RAD {
         "angles (deg/rad) compare with angles; `angle(u, v)` gives one".into()
     } else {
-        format!("both sides need the same unit (here {a} and {b}); a bare number takes the other side's unit")
+        format!(
+            "both sides need the same unit (here {a} and {b}); a bare number takes the other side's unit"
+        )
     }
 }

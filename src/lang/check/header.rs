@@ -10,8 +10,9 @@ use crate::skeleton::joint_index;
 use std::collections::{HashMap, HashSet};
 
 /// Names a person, parameter or function may not take.
-pub const RESERVED: &[&str] =
-    &["x", "y", "z", "xz", "me", "joints", "people", "start", "mid", "end", "true", "false"];
+pub const RESERVED: &[&str] = &[
+    "x", "y", "z", "xz", "me", "joints", "people", "start", "mid", "end", "true", "false",
+];
 
 impl<'a> Checker<'a> {
     /// Registers the library's functions and constants.
@@ -57,7 +58,10 @@ impl<'a> Checker<'a> {
             }
         }
         if self.header.people.is_empty() {
-            self.header.people.push(PersonInfo { name: "me".into(), prompt: self.header.prompt.clone() });
+            self.header.people.push(PersonInfo {
+                name: "me".into(),
+                prompt: self.header.prompt.clone(),
+            });
         }
         self.multi = self.header.people.len() > 1;
         self.declare_functions(module, &cx);
@@ -87,27 +91,49 @@ impl<'a> Checker<'a> {
 
     fn duplicate_header(&mut self, cx: &Cx, what: &str, span: Span, first: Span) {
         let line = self.line_of(first.start);
-        self.error(cx, "mprog::duplicate", span, format!("a second `{what}` line"))
-            .label("duplicate")
-            .help(format!("`{what}` is already given on line {line}; keep one"));
+        self.error(
+            cx,
+            "mprog::duplicate",
+            span,
+            format!("a second `{what}` line"),
+        )
+        .label("duplicate")
+        .help(format!(
+            "`{what}` is already given on line {line}; keep one"
+        ));
     }
 
     fn declare_people(&mut self, people: &[PersonDecl], cx: &Cx) {
         for p in people {
             let n = p.name.name.as_str();
             if joint_index(n).is_some() || RESERVED.contains(&n) {
-                self.error(cx, "mprog::reserved_name", p.name.span, format!("`{n}` cannot name a person"))
-                    .label("reserved")
-                    .help("it is a joint name or a keyword; use a short name such as `a`, `b`, `alice`");
+                self.error(
+                    cx,
+                    "mprog::reserved_name",
+                    p.name.span,
+                    format!("`{n}` cannot name a person"),
+                )
+                .label("reserved")
+                .help(
+                    "it is a joint name or a keyword; use a short name such as `a`, `b`, `alice`",
+                );
                 continue;
             }
             if self.header.people.iter().any(|q| q.name == n) {
-                self.error(cx, "mprog::duplicate", p.name.span, format!("person `{n}` is declared twice"))
-                    .label("duplicate")
-                    .help("give each person a different name");
+                self.error(
+                    cx,
+                    "mprog::duplicate",
+                    p.name.span,
+                    format!("person `{n}` is declared twice"),
+                )
+                .label("duplicate")
+                .help("give each person a different name");
                 continue;
             }
-            self.header.people.push(PersonInfo { name: n.to_string(), prompt: p.prompt.clone() });
+            self.header.people.push(PersonInfo {
+                name: n.to_string(),
+                prompt: p.prompt.clone(),
+            });
         }
     }
 
@@ -115,25 +141,45 @@ impl<'a> Checker<'a> {
         for item in &module.items {
             let Item::Def(f) = item else { continue };
             let n = f.name.name.as_str();
-            if super::builtins::find(n).is_some() || RESERVED.contains(&n) || joint_index(n).is_some() {
-                self.error(cx, "mprog::reserved_name", f.name.span, format!("`{n}` is a built-in name"))
-                    .label("cannot be redefined")
-                    .help("choose another function name");
+            if super::builtins::find(n).is_some()
+                || RESERVED.contains(&n)
+                || joint_index(n).is_some()
+            {
+                self.error(
+                    cx,
+                    "mprog::reserved_name",
+                    f.name.span,
+                    format!("`{n}` is a built-in name"),
+                )
+                .label("cannot be redefined")
+                .help("choose another function name");
                 continue;
             }
             if let Some(prev) = self.user_fns.get(n) {
                 let line = self.line_of(prev.span.start);
-                self.error(cx, "mprog::duplicate", f.name.span, format!("function `{n}` is defined twice"))
-                    .label("second definition")
-                    .help(format!("the first definition is on line {line}; rename or remove one"));
+                self.error(
+                    cx,
+                    "mprog::duplicate",
+                    f.name.span,
+                    format!("function `{n}` is defined twice"),
+                )
+                .label("second definition")
+                .help(format!(
+                    "the first definition is on line {line}; rename or remove one"
+                ));
                 continue;
             }
             let mut seen = HashSet::new();
             for p in &f.params {
                 if !seen.insert(p.name.as_str()) {
-                    self.error(cx, "mprog::duplicate", p.span, format!("parameter `{}` appears twice", p.name))
-                        .label("duplicate")
-                        .help("give each parameter a different name");
+                    self.error(
+                        cx,
+                        "mprog::duplicate",
+                        p.span,
+                        format!("parameter `{}` appears twice", p.name),
+                    )
+                    .label("duplicate")
+                    .help("give each parameter a different name");
                 }
             }
             self.user_fns.insert(n, f);
@@ -151,7 +197,9 @@ impl<'a> Checker<'a> {
                 FnBody::Block(items) => {
                     for i in items {
                         match i {
-                            FnItem::Let { value, .. } | FnItem::Expr(value) => calls_in(value, &mut calls),
+                            FnItem::Let { value, .. } | FnItem::Expr(value) => {
+                                calls_in(value, &mut calls)
+                            }
                         }
                     }
                 }
@@ -181,36 +229,70 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn declare_param(&mut self, name: &Ident, value: &'a Expr, span: Span, overrides: &[(String, f64)], cx: &Cx) {
+    fn declare_param(
+        &mut self,
+        name: &Ident,
+        value: &'a Expr,
+        span: Span,
+        overrides: &[(String, f64)],
+        cx: &Cx,
+    ) {
         let n = name.name.as_str();
         if joint_index(n).is_some()
             || RESERVED.contains(&n)
             || self.header.people.iter().any(|p| p.name == n)
             || super::builtins::find(n).is_some()
         {
-            self.error(cx, "mprog::reserved_name", name.span, format!("`{n}` cannot name a parameter"))
-                .label("already means something")
-                .help("it is a joint, person, keyword or built-in; choose another name");
+            self.error(
+                cx,
+                "mprog::reserved_name",
+                name.span,
+                format!("`{n}` cannot name a parameter"),
+            )
+            .label("already means something")
+            .help("it is a joint, person, keyword or built-in; choose another name");
             return;
         }
         if self.header.params.iter().any(|p| p.name == n) {
-            self.error(cx, "mprog::duplicate", name.span, format!("parameter `{n}` is declared twice"))
-                .label("duplicate")
-                .help("keep one `param` line per name");
+            self.error(
+                cx,
+                "mprog::duplicate",
+                name.span,
+                format!("parameter `{n}` is declared twice"),
+            )
+            .label("duplicate")
+            .help("keep one `param` line per name");
             return;
         }
         let val = self.expr(value, &None, cx);
         let Val::Num(num) = val else {
             if val != Val::Error {
-                self.error(cx, "mprog::type_mismatch", value.span, format!("a parameter must be a number or vector, not {}", val.describe()))
-                    .help("write e.g. `param diameter = 0.4 m` or `param target = [1, 0, 2]`");
+                self.error(
+                    cx,
+                    "mprog::type_mismatch",
+                    value.span,
+                    format!(
+                        "a parameter must be a number or vector, not {}",
+                        val.describe()
+                    ),
+                )
+                .help("write e.g. `param diameter = 0.4 m` or `param target = [1, 0, 2]`");
             }
             return;
         };
-        let Some(values) = self.b.const_of(num.node).map(|v| v.iter().map(|&x| f64::from(x)).collect::<Vec<f64>>()) else {
-            self.error(cx, "mprog::not_constant", value.span, "a parameter's value must be constant")
-                .label("depends on the motion")
-                .help("parameters are fixed numbers; use `let` for values computed from joints");
+        let Some(values) = self
+            .b
+            .const_of(num.node)
+            .map(|v| v.iter().map(|&x| f64::from(x)).collect::<Vec<f64>>())
+        else {
+            self.error(
+                cx,
+                "mprog::not_constant",
+                value.span,
+                "a parameter's value must be constant",
+            )
+            .label("depends on the motion")
+            .help("parameters are fixed numbers; use `let` for values computed from joints");
             return;
         };
         let scale = match &value.kind {
@@ -220,11 +302,21 @@ impl<'a> Checker<'a> {
         let mut values = values;
         if let Some((_, v)) = overrides.iter().rev().find(|(k, _)| k == n) {
             if num.vector {
-                self.error(cx, "mprog::bad_override", name.span, format!("`--set {n}=…` cannot replace a vector"))
-                    .help("only scalar parameters can be set from the command line");
+                self.error(
+                    cx,
+                    "mprog::bad_override",
+                    name.span,
+                    format!("`--set {n}=…` cannot replace a vector"),
+                )
+                .help("only scalar parameters can be set from the command line");
             } else if !v.is_finite() {
-                self.error(cx, "mprog::bad_override", name.span, format!("`--set {n}` needs a finite number"))
-                    .help("e.g. `--set diameter=0.5`");
+                self.error(
+                    cx,
+                    "mprog::bad_override",
+                    name.span,
+                    format!("`--set {n}` needs a finite number"),
+                )
+                .help("e.g. `--set diameter=0.5`");
             } else {
                 values = vec![v * scale];
             }
@@ -244,7 +336,9 @@ impl<'a> Checker<'a> {
     fn declare_length(&mut self, module: &'a Module, cx: &Cx) {
         let mut length = None;
         for item in &module.items {
-            let Item::Length { value, span } = item else { continue };
+            let Item::Length { value, span } = item else {
+                continue;
+            };
             if let Some((_, first)) = length {
                 self.duplicate_header(cx, "length", *span, first);
                 continue;
@@ -254,16 +348,29 @@ impl<'a> Checker<'a> {
                 continue;
             };
             if t.fraction != 0.0 {
-                self.error(cx, "mprog::bad_length", value.span, "the length cannot be relative to itself")
-                    .help("write `length 6s` or `length 120 frames`");
+                self.error(
+                    cx,
+                    "mprog::bad_length",
+                    value.span,
+                    "the length cannot be relative to itself",
+                )
+                .help("write `length 6s` or `length 120 frames`");
                 length = Some((None, *span));
                 continue;
             }
             let frames = t.frames.round();
             if !(2.0..=MAX_LENGTH as f64).contains(&frames) {
-                self.error(cx, "mprog::bad_length", value.span, format!("a length of {frames} frames is out of range"))
-                    .label("here")
-                    .help(format!("lengths go from 2 frames to {MAX_LENGTH} frames ({} s)", MAX_LENGTH / 20));
+                self.error(
+                    cx,
+                    "mprog::bad_length",
+                    value.span,
+                    format!("a length of {frames} frames is out of range"),
+                )
+                .label("here")
+                .help(format!(
+                    "lengths go from 2 frames to {MAX_LENGTH} frames ({} s)",
+                    MAX_LENGTH / 20
+                ));
                 length = Some((None, *span));
                 continue;
             }
@@ -280,8 +387,12 @@ impl<'a> Checker<'a> {
             Some((None, _)) => MODEL_MAX_FRAMES,
             None => {
                 self.diags.push(
-                    Diagnostic::warning("mprog::missing_length", Span::new(0, 0), "no `length` line; using 196 frames (9.8 s)")
-                        .help("add e.g. `length 6s` or `length 120 frames`"),
+                    Diagnostic::warning(
+                        "mprog::missing_length",
+                        Span::new(0, 0),
+                        "no `length` line; using 196 frames (9.8 s)",
+                    )
+                    .help("add e.g. `length 6s` or `length 120 frames`"),
                 );
                 MODEL_MAX_FRAMES
             }

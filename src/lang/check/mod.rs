@@ -122,8 +122,18 @@ impl<'a> Checker<'a> {
     }
 
     /// Shorthand for an error.
-    pub fn error(&mut self, cx: &Cx, code: &'static str, span: Span, msg: impl Into<String>) -> ErrorBuilder<'_, 'a> {
-        ErrorBuilder { checker: self, cx: cx.clone(), d: Some(Diagnostic::error(code, span, msg)) }
+    pub fn error(
+        &mut self,
+        cx: &Cx,
+        code: &'static str,
+        span: Span,
+        msg: impl Into<String>,
+    ) -> ErrorBuilder<'_, 'a> {
+        ErrorBuilder {
+            checker: self,
+            cx: cx.clone(),
+            d: Some(Diagnostic::error(code, span, msg)),
+        }
     }
 
     /// The 1-based line of a byte offset in the user's source.
@@ -200,7 +210,10 @@ pub fn module_to_ir<'a>(
             Diagnostic::error(
                 "mprog::too_costly",
                 Span::default(),
-                format!("the program expands to more than {} tensor ops", builder::MAX_NODES),
+                format!(
+                    "the program expands to more than {} tensor ops",
+                    builder::MAX_NODES
+                ),
             )
             .help("loops and functions are unrolled when checking; use fewer or smaller loops"),
         );
@@ -208,9 +221,15 @@ pub fn module_to_ir<'a>(
     let has_errors = c.diags.iter().any(|d| d.severity == Severity::Error);
     if c.statements.is_empty() && !has_errors {
         c.diags.push(
-            Diagnostic::error("mprog::empty_program", Span::new(0, 0), "the program has no constraints")
-                .label("nothing to satisfy here")
-                .help("add a constraint, e.g. `always { head.y > 1.5 m }` or `at end { pelvis.z > 2 m }`"),
+            Diagnostic::error(
+                "mprog::empty_program",
+                Span::new(0, 0),
+                "the program has no constraints",
+            )
+            .label("nothing to satisfy here")
+            .help(
+                "add a constraint, e.g. `always { head.y > 1.5 m }` or `at end { pelvis.z > 2 m }`",
+            ),
         );
     }
     if c.diags.iter().any(|d| d.severity == Severity::Error) {

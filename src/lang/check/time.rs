@@ -28,22 +28,32 @@ impl<'a> Checker<'a> {
                     None
                 }
             },
-            ExprKind::Name(n) if matches!(n.as_str(), "start" | "mid" | "end") => {
-                Some(tp(0.0, match n.as_str() {
+            ExprKind::Name(n) if matches!(n.as_str(), "start" | "mid" | "end") => Some(tp(
+                0.0,
+                match n.as_str() {
                     "start" => 0.0,
                     "mid" => 0.5,
                     _ => 1.0,
-                }))
-            }
+                },
+            )),
             ExprKind::Name(n) => {
-                if let Some(Binding::Thunk { expr, env: tenv, site }) = lookup(env, n) {
+                if let Some(Binding::Thunk {
+                    expr,
+                    env: tenv,
+                    site,
+                }) = lookup(env, n)
+                {
                     let inner = Cx { site, ..cx.clone() };
                     return self.time_point(expr, &tenv, &inner);
                 }
                 let param = self.header.params.iter().find(|p| &p.name == n).cloned();
                 match param {
-                    Some(p) if p.value.len() == 1 && p.unit_value == Unit::S => Some(tp(p.value[0] * fps, 0.0)),
-                    Some(p) if p.value.len() == 1 && p.unit_value == Unit::FREE => Some(tp(p.value[0], 0.0)),
+                    Some(p) if p.value.len() == 1 && p.unit_value == Unit::S => {
+                        Some(tp(p.value[0] * fps, 0.0))
+                    }
+                    Some(p) if p.value.len() == 1 && p.unit_value == Unit::FREE => {
+                        Some(tp(p.value[0], 0.0))
+                    }
                     Some(_) => {
                         self.not_a_time(e, cx, "a parameter that is not a time");
                         None
@@ -54,17 +64,19 @@ impl<'a> Checker<'a> {
                     }
                 }
             }
-            ExprKind::Unary(UnOp::Neg, a) => self.time_point(a, env, cx).map(|t| tp(-t.frames, -t.fraction)),
+            ExprKind::Unary(UnOp::Neg, a) => self
+                .time_point(a, env, cx)
+                .map(|t| tp(-t.frames, -t.fraction)),
             ExprKind::Binary(op @ (BinOp::Add | BinOp::Sub), a, b) => {
                 let (x, y) = (self.time_point(a, env, cx), self.time_point(b, env, cx));
                 let s = if *op == BinOp::Add { 1.0 } else { -1.0 };
                 Some(tp(x?.frames + s * y?.frames, x?.fraction + s * y?.fraction))
             }
             ExprKind::Binary(op @ (BinOp::Mul | BinOp::Div), a, b) => {
-                let (time, factor) = if *op == BinOp::Mul && self.plain_const(a, env, cx).is_some() {
-                    (b, self.plain_const(a, env, cx))
+                let (time, factor) = if *op == BinOp::Mul && self.plain_const(a, env).is_some() {
+                    (b, self.plain_const(a, env))
                 } else {
-                    (a, self.plain_const(b, env, cx))
+                    (a, self.plain_const(b, env))
                 };
                 let Some(k) = factor else {
                     self.not_a_time(e, cx, "a product of two times");
@@ -80,7 +92,8 @@ impl<'a> Checker<'a> {
                 } else {
                     k
                 };
-                self.time_point(time, env, cx).map(|t| tp(t.frames * k, t.fraction * k))
+                self.time_point(time, env, cx)
+                    .map(|t| tp(t.frames * k, t.fraction * k))
             }
             ExprKind::Error => None,
             _ => {
@@ -91,23 +104,30 @@ impl<'a> Checker<'a> {
     }
 
     /// A constant plain number (no unit), if `e` is one; reports nothing.
-    fn plain_const(&mut self, e: &'a Expr, env: &Env<'a>, cx: &Cx) -> Option<f64> {
+    fn plain_const(&self, e: &'a Expr, env: &Env<'a>) -> Option<f64> {
         match &e.kind {
             ExprKind::Number(v, None) => Some(*v),
             ExprKind::Name(n) if lookup(env, n).is_none() => {
                 let p = self.header.params.iter().find(|p| &p.name == n)?;
                 (p.value.len() == 1 && p.unit_value.is_plain()).then(|| p.value[0])
             }
-            ExprKind::Unary(UnOp::Neg, a) => self.plain_const(a, env, cx).map(|v| -v),
+            ExprKind::Unary(UnOp::Neg, a) => self.plain_const(a, env).map(|v| -v),
             _ => None,
         }
     }
 
     fn not_a_time(&mut self, e: &Expr, cx: &Cx, what: &str) {
-        self.error(cx, "mprog::not_a_time", e.span, format!("expected a time position, found {what}"))
-            .label("not a time")
-            .help("times are frame numbers (`40`), seconds (`2s`), `40 frames`, percentages (`50%`), \
-                   `start`, `mid`, `end`, or sums like `end - 1`");
+        self.error(
+            cx,
+            "mprog::not_a_time",
+            e.span,
+            format!("expected a time position, found {what}"),
+        )
+        .label("not a time")
+        .help(
+            "times are frame numbers (`40`), seconds (`2s`), `40 frames`, percentages (`50%`), \
+                   `start`, `mid`, `end`, or sums like `end - 1`",
+        );
     }
 
     /// Reports a time outside `[0, length - 1]`; true when it is inside.
@@ -117,13 +137,18 @@ impl<'a> Checker<'a> {
         if (0.0..=(len - 1) as f64).contains(&f) {
             return true;
         }
-        self.error(cx, "mprog::time_out_of_range", span, format!("frame {f} is outside the motion"))
-            .label(format!("frame {f}"))
-            .help(format!(
-                "the motion has {len} frames ({:.2} s), numbered 0 to {}; use `end` for the last frame",
-                len as f64 / f64::from(FPS),
-                len - 1
-            ));
+        self.error(
+            cx,
+            "mprog::time_out_of_range",
+            span,
+            format!("frame {f} is outside the motion"),
+        )
+        .label(format!("frame {f}"))
+        .help(format!(
+            "the motion has {len} frames ({:.2} s), numbered 0 to {}; use `end` for the last frame",
+            len as f64 / f64::from(FPS),
+            len - 1
+        ));
         false
     }
 
@@ -132,7 +157,11 @@ impl<'a> Checker<'a> {
         let len = self.header.length;
         let (fa, fb) = (a.frame_unclamped(len), b.frame_unclamped(len));
         if fa < 0.0 || fb > len as f64 || fa >= fb {
-            let why = if fa >= fb { format!("from frame {fa} to {fb} is empty") } else { format!("frames {fa}..{fb} leave the motion") };
+            let why = if fa >= fb {
+                format!("from frame {fa} to {fb} is empty")
+            } else {
+                format!("frames {fa}..{fb} leave the motion")
+            };
             self.error(cx, "mprog::time_out_of_range", span, format!("the range {why}"))
                 .label("bad range")
                 .help(format!(

@@ -19,15 +19,40 @@ pub struct Unit {
 
 impl Unit {
     /// A bare number.
-    pub const FREE: Unit = Unit { len: 0, time: 0, angle: 0, free: true };
+    pub const FREE: Unit = Unit {
+        len: 0,
+        time: 0,
+        angle: 0,
+        free: true,
+    };
     /// Dimensionless (ratios, cosines, weights of a dot product of unit vectors).
-    pub const ONE: Unit = Unit { len: 0, time: 0, angle: 0, free: false };
+    pub const ONE: Unit = Unit {
+        len: 0,
+        time: 0,
+        angle: 0,
+        free: false,
+    };
     /// Metres.
-    pub const M: Unit = Unit { len: 1, time: 0, angle: 0, free: false };
+    pub const M: Unit = Unit {
+        len: 1,
+        time: 0,
+        angle: 0,
+        free: false,
+    };
     /// Seconds.
-    pub const S: Unit = Unit { len: 0, time: 1, angle: 0, free: false };
+    pub const S: Unit = Unit {
+        len: 0,
+        time: 1,
+        angle: 0,
+        free: false,
+    };
     /// Radians.
-    pub const RAD: Unit = Unit { len: 0, time: 0, angle: 1, free: false };
+    pub const RAD: Unit = Unit {
+        len: 0,
+        time: 0,
+        angle: 1,
+        free: false,
+    };
 
     /// The unit of `a + b`, `a < b`, `min(a, b)`: both must agree unless one is free.
     pub fn unify(self, other: Unit) -> Option<Unit> {
@@ -41,7 +66,7 @@ impl Unit {
     }
 
     /// The unit of `a * b`.
-    pub fn mul(self, other: Unit) -> Unit {
+    pub fn times(self, other: Unit) -> Unit {
         if self.free && other.free {
             return Unit::FREE;
         }
@@ -54,13 +79,23 @@ impl Unit {
     }
 
     /// The unit of `a / b`.
-    pub fn div(self, other: Unit) -> Unit {
-        self.mul(Unit { len: -other.len, time: -other.time, angle: -other.angle, ..other })
+    pub fn per(self, other: Unit) -> Unit {
+        self.times(Unit {
+            len: -other.len,
+            time: -other.time,
+            angle: -other.angle,
+            ..other
+        })
     }
 
     /// The unit of `a^n`.
     pub fn pow(self, n: i8) -> Unit {
-        Unit { len: self.len * n, time: self.time * n, angle: self.angle * n, free: self.free }
+        Unit {
+            len: self.len * n,
+            time: self.time * n,
+            angle: self.angle * n,
+            free: self.free,
+        }
     }
 
     /// Half the exponents (for `sqrt`), if they are even.
@@ -104,8 +139,16 @@ impl fmt::Display for Unit {
                 _ => den.push(part),
             }
         }
-        let num = if num.is_empty() { "1".to_string() } else { num.join("·") };
-        if den.is_empty() { f.write_str(&num) } else { write!(f, "{num}/{}", den.join("·")) }
+        let num = if num.is_empty() {
+            "1".to_string()
+        } else {
+            num.join("·")
+        };
+        if den.is_empty() {
+            f.write_str(&num)
+        } else {
+            write!(f, "{num}/{}", den.join("·"))
+        }
     }
 }
 
@@ -117,10 +160,10 @@ mod tests {
     fn units_combine() {
         assert_eq!(Unit::FREE.unify(Unit::M), Some(Unit::M));
         assert_eq!(Unit::M.unify(Unit::S), None);
-        assert_eq!(Unit::M.div(Unit::S).to_string(), "m/s");
-        assert_eq!(Unit::M.div(Unit::S.pow(2)).to_string(), "m/s²");
-        assert_eq!(Unit::M.mul(Unit::M).sqrt(), Some(Unit::M));
-        assert_eq!(Unit::FREE.mul(Unit::M), Unit::M);
-        assert_eq!(Unit::M.div(Unit::M).to_string(), "1");
+        assert_eq!(Unit::M.per(Unit::S).to_string(), "m/s");
+        assert_eq!(Unit::M.per(Unit::S.pow(2)).to_string(), "m/s²");
+        assert_eq!(Unit::M.times(Unit::M).sqrt(), Some(Unit::M));
+        assert_eq!(Unit::FREE.times(Unit::M), Unit::M);
+        assert_eq!(Unit::M.per(Unit::M).to_string(), "1");
     }
 }

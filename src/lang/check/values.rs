@@ -47,7 +47,13 @@ pub struct Num {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Formula {
     /// `a op b` with both sides already elaborated.
-    Cmp { op: BinOp, a: NodeId, b: NodeId, unit: Unit, span: Span },
+    Cmp {
+        op: BinOp,
+        a: NodeId,
+        b: NodeId,
+        unit: Unit,
+        span: Span,
+    },
     /// Sum of errors / both conditions.
     And(Rc<Formula>, Rc<Formula>),
     /// Minimum of errors / either condition.
@@ -72,7 +78,10 @@ pub enum Val {
     /// Scalar or vector.
     Num(Num),
     /// A joint of a person (`person` is `None` for a bare joint in a multi-person program).
-    Joint { person: Option<LaneVec>, joint: LaneVec },
+    Joint {
+        person: Option<LaneVec>,
+        joint: LaneVec,
+    },
     /// A person.
     Person(LaneVec),
     /// A finite list of joints, for loops.
@@ -115,7 +124,11 @@ pub enum LoopItem {
 pub enum Binding<'a> {
     /// A `let` or a function argument: re-elaborated where used (call by name), with the
     /// scope and library call site it was written in.
-    Thunk { expr: &'a Expr, env: Env<'a>, site: Option<Span> },
+    Thunk {
+        expr: &'a Expr,
+        env: Env<'a>,
+        site: Option<Span>,
+    },
     /// The variable of loop level `n`.
     Loop(usize),
 }
@@ -133,7 +146,11 @@ pub type Env<'a> = Option<Rc<Scope<'a>>>;
 
 /// Adds a binding in front of `env`.
 pub fn bind<'a>(env: &Env<'a>, name: &'a str, binding: Binding<'a>) -> Env<'a> {
-    Some(Rc::new(Scope { name, binding, next: env.clone() }))
+    Some(Rc::new(Scope {
+        name,
+        binding,
+        next: env.clone(),
+    }))
 }
 
 /// Finds the innermost binding of `name`.
@@ -177,7 +194,13 @@ pub struct Cx {
 impl Cx {
     /// The top-level context: every frame, no loops.
     pub fn top() -> Self {
-        Cx { domain: 0, site: None, depth: 0, loops: Rc::new(Vec::new()), lanes: 1 }
+        Cx {
+            domain: 0,
+            site: None,
+            depth: 0,
+            loops: Rc::new(Vec::new()),
+            lanes: 1,
+        }
     }
 
     /// Item index of loop `level` for each lane.
@@ -187,6 +210,8 @@ impl Cx {
         if self.lanes == 1 {
             return LaneVec::One(0);
         }
-        LaneVec::Lanes(Rc::new((0..self.lanes).map(|l| (l / stride) % len).collect()))
+        LaneVec::Lanes(Rc::new(
+            (0..self.lanes).map(|l| (l / stride) % len).collect(),
+        ))
     }
 }

@@ -46,6 +46,7 @@ struct CachedIndices {
     frames: usize,
     device: burn::tensor::Device,
     gathers: HashMap<NodeId, Tensor<1, Int>>,
+    consts: HashMap<NodeId, Tensor<4>>,
     domain_sizes: Vec<usize>,
 }
 
@@ -67,14 +68,29 @@ fn flat(person: usize, frame: usize, joint: usize, frames: usize) -> i64 {
 }
 
 fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> CachedIndices {
-    let domain_sizes: Vec<usize> = (0..ir.domains.len()).map(|d| ir.resolve_domain(d, frames).len()).collect();
+    let domain_sizes: Vec<usize> = (0..ir.domains.len())
+        .map(|d| ir.resolve_domain(d, frames).len())
+        .collect();
     let mut gathers = HashMap::new();
+    let mut consts = HashMap::new();
     for (i, node) in ir.nodes.iter().enumerate() {
+        if let Op::Const(v) = &node.op {
+            let c = v.len();
+            let t = Tensor::<1>::from_data(TensorData::new(v.clone(), [c]), device)
+                .reshape([1, 1, 1, c]);
+            consts.insert(i, t);
+        }
         let (domain, points): (DomainId, Vec<(usize, usize)>) = match &node.op {
             Op::Gather { domain, points } => (*domain, points.clone()),
-            Op::MassCenter { domain, persons, .. } => {
-                (*domain, persons.iter().flat_map(|&p| (0..NUM_JOINTS).map(move |j| (p, j))).collect())
-            }
+            Op::MassCenter {
+                domain, persons, ..
+            } => (
+                *domain,
+                persons
+                    .iter()
+                    .flat_map(|&p| (0..NUM_JOINTS).map(move |j| (p, j)))
+                    .collect(),
+            ),
             _ => continue,
         };
         let mut ts = ir.resolve_domain(domain, frames);
@@ -87,39 +103,54 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
             .flat_map(|&t| points.iter().map(move |&(p, j)| flat(p, t, j, frames)))
             .collect();
         let n = idx.len();
-        gathers.insert(i, Tensor::<1, Int>::from_data(TensorData::new(idx, [n]), device));
+        gathers.insert(
+            i,
+            Tensor::<1, Int>::from_data(TensorData::new(idx, [n]), device),
+        );
     }
-    CachedIndices { frames, device: device.clone(), gathers, domain_sizes }
+    CachedIndices {
+        frames,
+        device: device.clone(),
+        gathers,
+        consts,
+        domain_sizes,
+    }
 }
 
 /// Evaluates `ir` on joint positions `[batch, people, frames, 22, 3]`.
 pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evaluation, EvalError> {
     let [batch, people, frames, nj, nc] = joints.dims();
     if people != ir.people || nj != NUM_JOINTS || nc != 3 || frames == 0 || batch == 0 {
-        return Err(EvalError::BadShape { got: vec![batch, people, frames, nj, nc], people: ir.people });
+        return Err(EvalError::BadShape {
+            got: vec![batch, people, frames, nj, nc],
+            people: ir.people,
+        });
     }
     let device = joints.device();
     let mut guard = cache.inner.lock().unwrap_or_else(|e| e.into_inner());
-    let stale = guard.as_ref().is_none_or(|c| c.frames != frames || c.device != device);
+    let stale = guard
+        .as_ref()
+        .is_none_or(|c| c.frames != frames || c.device != device);
     if stale {
         *guard = Some(build_indices(ir, frames, &device));
     }
-    let Some(idx) = guard.as_ref() else { unreachable!("cache filled above") };
+    let Some(idx) = guard.as_ref() else {
+        unreachable!("cache filled above")
+    };
     // [batch, people·frames·22, 3]
     let rows = joints.reshape([batch, people * frames * NUM_JOINTS, 3]);
     let mut values: Vec<Option<Tensor<4>>> = vec![None; ir.nodes.len()];
     let last_use = last_uses(ir);
     for (i, node) in ir.nodes.iter().enumerate() {
-        let get = |values: &Vec<Option<Tensor<4>>>, a: NodeId| values[a].clone().expect("nodes are in SSA order");
+        let get = |values: &Vec<Option<Tensor<4>>>, a: NodeId| {
+            values[a].clone().expect("nodes are in SSA order")
+        };
         let frames_of = |n: &Node| match n.frames {
             Frames::Const => 1,
             Frames::Domain(d) => idx.domain_sizes[d].max(1),
         };
         let t = match &node.op {
-            Op::Const(v) => {
-                let c = v.len();
-                Tensor::<1>::from_data(TensorData::new(v.clone(), [c]), &device).reshape([1, 1, 1, c])
-            }
+            Op::Const(_) => idx.consts[&i].clone(),
             Op::Gather { .. } => {
                 // [batch, |D|·K, 3] → [batch, |D|, K, 3]
                 let g = rows.clone().select(1, idx.gathers[&i].clone());
@@ -129,9 +160,12 @@ pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evalua
                 let g = rows.clone().select(1, idx.gathers[&i].clone());
                 // [batch, |D|, K, 22, 3] weighted over joints → [batch, |D|, K, 3]
                 let g: Tensor<5> = g.reshape([batch, frames_of(node), node.lanes, NUM_JOINTS, 3]);
-                let w = Tensor::<1>::from_data(TensorData::new(weights.clone(), [NUM_JOINTS]), &device)
-                    .reshape([1, 1, 1, NUM_JOINTS, 1]);
-                (g * w).sum_dim(3).reshape([batch, frames_of(node), node.lanes, 3])
+                let w =
+                    Tensor::<1>::from_data(TensorData::new(weights.clone(), [NUM_JOINTS]), &device)
+                        .reshape([1, 1, 1, NUM_JOINTS, 1]);
+                (g * w)
+                    .sum_dim(3)
+                    .reshape([batch, frames_of(node), node.lanes, 3])
             }
             Op::Component { arg, axis } => get(&values, *arg).narrow(3, *axis, 1),
             Op::Compose(parts) => {
@@ -142,7 +176,11 @@ pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evalua
             Op::Unary { op, arg } => ops::unary(*op, get(&values, *arg)),
             Op::Binary { op, a, b } => ops::binary(*op, get(&values, *a), get(&values, *b)),
             Op::SumChannels(a) => get(&values, *a).sum_dim(3),
-            Op::Norm(a) => get(&values, *a).square().sum_dim(3).add_scalar(1e-12).sqrt(),
+            Op::Norm(a) => get(&values, *a)
+                .square()
+                .sum_dim(3)
+                .add_scalar(1e-12)
+                .sqrt(),
             Op::Cross(a, b) => {
                 let (x, y) = (get(&values, *a), get(&values, *b));
                 let shape = ops::common_shape(&[&x, &y], 3);
@@ -172,9 +210,16 @@ pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evalua
         columns.push(statement_error(ir, s, &values, idx, batch, &device));
     }
     drop(guard);
-    let per_statement = Tensor::cat(columns, 1);
+    let per_statement = if columns.len() == 1 {
+        columns.remove(0)
+    } else {
+        Tensor::cat(columns, 1)
+    };
     let total = per_statement.clone().sum_dim(1).reshape([batch]);
-    Ok(Evaluation { total, per_statement })
+    Ok(Evaluation {
+        total,
+        per_statement,
+    })
 }
 
 /// For each node, the last node that reads it (statements count as reading at the end).
@@ -222,7 +267,22 @@ fn statement_error(
     };
     let factor = s.weight * (s.lanes / lanes.max(1)) as f64;
     let b = reduced.dims()[0];
-    let col = reduced.sum_dim(2).reshape([b, 1]).mul_scalar(factor);
+    // Skip no-op tensor ops: each costs a few µs of dispatch and tape at small sizes.
+    let reduced = if lanes > 1 {
+        reduced.sum_dim(2)
+    } else {
+        reduced
+    };
+    let col = reduced.reshape([b, 1]);
+    let col = if factor == 1.0 {
+        col
+    } else {
+        col.mul_scalar(factor)
+    };
     let _ = ir;
-    if b == batch { col } else { col.expand([batch, 1]) }
+    if b == batch {
+        col
+    } else {
+        col.expand([batch, 1])
+    }
 }

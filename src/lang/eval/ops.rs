@@ -70,21 +70,34 @@ pub fn support_dist(point: Tensor<4>, feet: Tensor<4>, lanes: usize) -> Tensor<4
     let [pb, pf, pk, _] = point.dims();
     let p: Tensor<5> = point.reshape([pb, pf, pk, 1, 3]);
     let p = Tensor::cat(vec![p.clone().narrow(4, 0, 1), p.narrow(4, 2, 1)], 4); // [B, F, K, 1, 2]
-    let sel = |ids: Vec<i64>| Tensor::<1, burn::tensor::Int>::from_data(burn::tensor::TensorData::new(ids, [6]), &device);
-    let a = pts.clone().select(3, sel(PAIRS.iter().map(|p| p.0 as i64).collect())); // [B, F, K, 6, 2]
-    let e = pts.clone().select(3, sel(PAIRS.iter().map(|p| p.1 as i64).collect()));
+    let sel = |ids: Vec<i64>| {
+        Tensor::<1, burn::tensor::Int>::from_data(burn::tensor::TensorData::new(ids, [6]), &device)
+    };
+    let a = pts
+        .clone()
+        .select(3, sel(PAIRS.iter().map(|p| p.0 as i64).collect())); // [B, F, K, 6, 2]
+    let e = pts
+        .clone()
+        .select(3, sel(PAIRS.iter().map(|p| p.1 as i64).collect()));
     let ab = e - a.clone();
     let ap = p.clone() - a.clone();
     // Distance to each segment: |ap − clamp(ap·ab / |ab|², 0, 1) ab|.
     let len2 = ab.clone().square().sum_dim(4).add_scalar(1e-12);
     let t = ((ap.clone() * ab.clone()).sum_dim(4) / len2).clamp(0.0, 1.0);
-    let d = (ap.clone() - ab.clone() * t).square().sum_dim(4).add_scalar(1e-12).sqrt(); // [B, F, K, 6, 1]
+    let d = (ap.clone() - ab.clone() * t)
+        .square()
+        .sum_dim(4)
+        .add_scalar(1e-12)
+        .sqrt(); // [B, F, K, 6, 1]
     // Side of the point and of the other two foot points for each segment (no gradient).
     let cross = |u: Tensor<5>, v: Tensor<5>| {
-        u.clone().narrow(4, 0, 1) * v.clone().narrow(4, 1, 1) - u.narrow(4, 1, 1) * v.narrow(4, 0, 1)
+        u.clone().narrow(4, 0, 1) * v.clone().narrow(4, 1, 1)
+            - u.narrow(4, 1, 1) * v.narrow(4, 0, 1)
     };
     let others: [(usize, usize); 6] = [(2, 3), (1, 3), (1, 2), (0, 3), (0, 2), (0, 1)];
-    let o1 = pts.clone().select(3, sel(others.iter().map(|o| o.0 as i64).collect()));
+    let o1 = pts
+        .clone()
+        .select(3, sel(others.iter().map(|o| o.0 as i64).collect()));
     let o2 = pts.select(3, sel(others.iter().map(|o| o.1 as i64).collect()));
     let s1 = cross(ab.clone(), o1 - a.clone()).detach();
     let s2 = cross(ab.clone(), o2 - a).detach();

@@ -48,7 +48,11 @@ pub enum Item {
     /// `length 6s`.
     Length { value: Expr, span: Span },
     /// `param name = value`.
-    Param { name: Ident, value: Expr, span: Span },
+    Param {
+        name: Ident,
+        value: Expr,
+        span: Span,
+    },
     /// `people a "…", b "…"`.
     People { people: Vec<PersonDecl>, span: Span },
     /// `def f(a, b) = …` or `def f(a) { … }`.
@@ -115,19 +119,51 @@ pub enum TimeKind {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum Stmt {
     /// `let name = value` (lazy: the value is re-evaluated where it is used).
-    Let { name: Ident, value: Expr, span: Span },
+    Let {
+        name: Ident,
+        value: Expr,
+        span: Span,
+    },
     /// `always/at/during … { … }`.
-    Time { kind: TimeKind, weight: Option<Expr>, body: Vec<Stmt>, span: Span },
+    Time {
+        kind: TimeKind,
+        weight: Option<Expr>,
+        body: Vec<Stmt>,
+        span: Span,
+    },
     /// `for var in set { … }`.
-    For { var: Ident, set: Expr, body: Vec<Stmt>, span: Span },
+    For {
+        var: Ident,
+        set: Expr,
+        body: Vec<Stmt>,
+        span: Span,
+    },
     /// `if cond { … } else { … }`.
-    If { cond: Expr, then: Vec<Stmt>, otherwise: Option<Vec<Stmt>>, span: Span },
+    If {
+        cond: Expr,
+        then: Vec<Stmt>,
+        otherwise: Option<Vec<Stmt>>,
+        span: Span,
+    },
     /// `weight w { … }`.
-    Weight { weight: Expr, body: Vec<Stmt>, span: Span },
+    Weight {
+        weight: Expr,
+        body: Vec<Stmt>,
+        span: Span,
+    },
     /// `minimize e` (`sign` 1) or `maximize e` (`sign` -1).
-    Minimize { value: Expr, sign: f64, weight: Option<Expr>, span: Span },
+    Minimize {
+        value: Expr,
+        sign: f64,
+        weight: Option<Expr>,
+        span: Span,
+    },
     /// A constraint expression, optionally `weight w`.
-    Constraint { value: Expr, weight: Option<Expr>, span: Span },
+    Constraint {
+        value: Expr,
+        weight: Option<Expr>,
+        span: Span,
+    },
 }
 
 impl Stmt {
@@ -213,7 +249,10 @@ impl BinOp {
 
     /// True for `== < <= > >=`.
     pub fn is_comparison(self) -> bool {
-        matches!(self, BinOp::Eq | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge)
+        matches!(
+            self,
+            BinOp::Eq | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge
+        )
     }
 }
 

@@ -47,7 +47,10 @@ pub fn source_to_ast(source: &str) -> (Module, Vec<Diagnostic>) {
         Ok(mut p) => p.next().map(|p| p.into_inner()),
         Err(e) => return (Module::default(), vec![syntax_error(e, source)]),
     };
-    let builder = Builder { source, diags: RefCell::new(Vec::new()) };
+    let builder = Builder {
+        source,
+        diags: RefCell::new(Vec::new()),
+    };
     let mut module = Module::default();
     for pair in pairs.into_iter().flatten() {
         if let Some(item) = builder.item(pair) {
@@ -64,7 +67,10 @@ fn check_limits(source: &str) -> Option<Diagnostic> {
             Diagnostic::error(
                 "mprog::too_large",
                 Span::new(0, 0),
-                format!("the program is {} bytes; the limit is {MAX_SOURCE_BYTES}", source.len()),
+                format!(
+                    "the program is {} bytes; the limit is {MAX_SOURCE_BYTES}",
+                    source.len()
+                ),
             )
             .help("split the task into smaller programs or use functions and loops"),
         );
@@ -89,7 +95,9 @@ fn check_limits(source: &str) -> Option<Diagnostic> {
                         Diagnostic::error(
                             "mprog::too_deep",
                             Span::new(i, i + 1),
-                            format!("brackets are nested more than {MAX_BRACKET_DEPTH} levels deep"),
+                            format!(
+                                "brackets are nested more than {MAX_BRACKET_DEPTH} levels deep"
+                            ),
                         )
                         .label("too deep")
                         .help("flatten the expression with `let` bindings or functions"),
@@ -148,13 +156,14 @@ fn syntax_error(e: pest::error::Error<Rule>, source: &str) -> Diagnostic {
         InputLocation::Pos(p) => (p, p),
         InputLocation::Span((a, b)) => (a, b),
     };
-    let found = source[start.min(source.len())..]
-        .chars()
-        .next()
-        .map_or("end of file".to_string(), |c| match c {
-            '\n' => "end of line".to_string(),
-            c => format!("`{c}`"),
-        });
+    let found =
+        source[start.min(source.len())..]
+            .chars()
+            .next()
+            .map_or("end of file".to_string(), |c| match c {
+                '\n' => "end of line".to_string(),
+                c => format!("`{c}`"),
+            });
     let (message, expected) = match &e.variant {
         ErrorVariant::ParsingError { positives, .. } => {
             let mut names: Vec<String> = positives.iter().map(rule_name).collect();
@@ -172,7 +181,11 @@ fn syntax_error(e: pest::error::Error<Rule>, source: &str) -> Diagnostic {
         }
         ErrorVariant::CustomError { message } => (message.clone(), String::new()),
     };
-    let end = if end == start { (start + found_len(source, start)).min(source.len()) } else { end };
+    let end = if end == start {
+        (start + found_len(source, start)).min(source.len())
+    } else {
+        end
+    };
     let mut d = Diagnostic::error("mprog::syntax", Span::new(start, end), message);
     if !expected.is_empty() {
         d = d.label(format!("expected {expected}"));
@@ -181,13 +194,18 @@ fn syntax_error(e: pest::error::Error<Rule>, source: &str) -> Diagnostic {
 }
 
 fn found_len(source: &str, at: usize) -> usize {
-    source.get(at..).and_then(|s| s.chars().next()).map_or(0, char::len_utf8)
+    source
+        .get(at..)
+        .and_then(|s| s.chars().next())
+        .map_or(0, char::len_utf8)
 }
 
 /// A hint for the most common slips, judged from the text around the error.
 fn syntax_hint(source: &str, at: usize) -> String {
     let rest = source.get(at..).unwrap_or("");
-    let line_start = source[..at.min(source.len())].rfind('\n').map_or(0, |i| i + 1);
+    let line_start = source[..at.min(source.len())]
+        .rfind('\n')
+        .map_or(0, |i| i + 1);
     let line = source[line_start..].lines().next().unwrap_or("");
     let opened = source.matches('{').count();
     if rest.is_empty() && opened > source.matches('}').count() {
@@ -226,11 +244,18 @@ impl Builder<'_> {
                 let text = unescape(pair.into_inner().next()?.into_inner().next()?.as_str());
                 Item::Prompt { text, span }
             }
-            Rule::length_decl => Item::Length { value: self.expr(pair.into_inner().next()?), span },
+            Rule::length_decl => Item::Length {
+                value: self.expr(pair.into_inner().next()?),
+                span,
+            },
             Rule::param_decl => {
                 let mut inner = pair.into_inner();
                 let name = ident(inner.next()?);
-                Item::Param { name, value: self.expr(inner.next()?), span }
+                Item::Param {
+                    name,
+                    value: self.expr(inner.next()?),
+                    span,
+                }
             }
             Rule::people_decl => {
                 let people = pair
@@ -269,7 +294,10 @@ impl Builder<'_> {
                             Rule::let_stmt => {
                                 let mut li = i.into_inner();
                                 let name = ident(li.next()?);
-                                Some(FnItem::Let { name, value: self.expr(li.next()?) })
+                                Some(FnItem::Let {
+                                    name,
+                                    value: self.expr(li.next()?),
+                                })
                             }
                             Rule::expr => Some(FnItem::Expr(self.expr(i))),
                             _ => None,
@@ -281,7 +309,13 @@ impl Builder<'_> {
                 _ => {}
             }
         }
-        Some(FnDef { name, params, body: body?, doc: doc_above(self.source, span.start), span })
+        Some(FnDef {
+            name,
+            params,
+            body: body?,
+            doc: doc_above(self.source, span.start),
+            span,
+        })
     }
 
     fn block(&self, pair: Pair<Rule>) -> Vec<Stmt> {
@@ -289,7 +323,8 @@ impl Builder<'_> {
     }
 
     fn weight(&self, pair: Option<Pair<Rule>>) -> Option<Expr> {
-        pair.and_then(|p| p.into_inner().next()).map(|e| self.expr(e))
+        pair.and_then(|p| p.into_inner().next())
+            .map(|e| self.expr(e))
     }
 
     fn stmt(&self, pair: Pair<Rule>) -> Option<Stmt> {
@@ -299,7 +334,11 @@ impl Builder<'_> {
         Some(match rule {
             Rule::let_stmt => {
                 let name = ident(inner.next()?);
-                Stmt::Let { name, value: self.expr(inner.next()?), span }
+                Stmt::Let {
+                    name,
+                    value: self.expr(inner.next()?),
+                    span,
+                }
             }
             Rule::always_block | Rule::at_block | Rule::during_block => {
                 let kind = match rule {
@@ -321,12 +360,22 @@ impl Builder<'_> {
                         _ => {}
                     }
                 }
-                Stmt::Time { kind, weight, body, span }
+                Stmt::Time {
+                    kind,
+                    weight,
+                    body,
+                    span,
+                }
             }
             Rule::for_stmt => {
                 let var = ident(inner.next()?);
                 let set = self.expr(inner.next()?);
-                Stmt::For { var, set, body: self.block(inner.next()?), span }
+                Stmt::For {
+                    var,
+                    set,
+                    body: self.block(inner.next()?),
+                    span,
+                }
             }
             Rule::if_stmt => {
                 let cond = self.expr(inner.next()?);
@@ -335,20 +384,42 @@ impl Builder<'_> {
                     Rule::if_stmt => self.stmt(p).into_iter().collect(),
                     _ => self.block(p),
                 });
-                Stmt::If { cond, then, otherwise, span }
+                Stmt::If {
+                    cond,
+                    then,
+                    otherwise,
+                    span,
+                }
             }
             Rule::weight_block => {
                 let weight = self.expr(inner.next()?);
-                Stmt::Weight { weight, body: self.block(inner.next()?), span }
+                Stmt::Weight {
+                    weight,
+                    body: self.block(inner.next()?),
+                    span,
+                }
             }
             Rule::minimize_stmt | Rule::maximize_stmt => {
                 let value = self.expr(inner.next()?);
-                let sign = if rule == Rule::minimize_stmt { 1.0 } else { -1.0 };
-                Stmt::Minimize { value, sign, weight: self.weight(inner.next()), span }
+                let sign = if rule == Rule::minimize_stmt {
+                    1.0
+                } else {
+                    -1.0
+                };
+                Stmt::Minimize {
+                    value,
+                    sign,
+                    weight: self.weight(inner.next()),
+                    span,
+                }
             }
             Rule::expr_stmt => {
                 let value = self.expr(inner.next()?);
-                Stmt::Constraint { value, weight: self.weight(inner.next()), span }
+                Stmt::Constraint {
+                    value,
+                    weight: self.weight(inner.next()),
+                    span,
+                }
             }
             _ => return None,
         })
@@ -373,7 +444,13 @@ impl Builder<'_> {
                 );
             }
             if depth > MAX_EXPR_DEPTH {
-                (Expr { kind: ExprKind::Error, span: e.span }, depth)
+                (
+                    Expr {
+                        kind: ExprKind::Error,
+                        span: e.span,
+                    },
+                    depth,
+                )
             } else {
                 (e, depth)
             }
@@ -382,21 +459,40 @@ impl Builder<'_> {
             .map_primary(|p| self.primary(p))
             .map_prefix(|op, (rhs, d)| {
                 let span = span_of(&op).to(rhs.span);
-                let op = if op.as_rule() == Rule::neg { UnOp::Neg } else { UnOp::Not };
-                guard(Expr { kind: ExprKind::Unary(op, Box::new(rhs)), span }, d + 1)
+                let op = if op.as_rule() == Rule::neg {
+                    UnOp::Neg
+                } else {
+                    UnOp::Not
+                };
+                guard(
+                    Expr {
+                        kind: ExprKind::Unary(op, Box::new(rhs)),
+                        span,
+                    },
+                    d + 1,
+                )
             })
             .map_postfix(|(lhs, d), op| {
                 let span = lhs.span.to(span_of(&op));
                 let rule = op.as_rule();
                 let Some(arg) = op.into_inner().next() else {
-                    return (Expr { kind: ExprKind::Error, span }, d);
+                    return (
+                        Expr {
+                            kind: ExprKind::Error,
+                            span,
+                        },
+                        d,
+                    );
                 };
                 let kind = if rule == Rule::member {
                     ExprKind::Member(Box::new(lhs), ident(arg))
                 } else {
                     let (t, td) = self.primary(arg);
                     return guard(
-                        Expr { kind: ExprKind::At(Box::new(lhs), Box::new(t)), span },
+                        Expr {
+                            kind: ExprKind::At(Box::new(lhs), Box::new(t)),
+                            span,
+                        },
                         d.max(td) + 1,
                     );
                 };
@@ -460,13 +556,27 @@ impl Builder<'_> {
             Rule::expr => self.expr_depth(pair),
             Rule::list => {
                 let (items, depth) = self.exprs(pair.into_inner());
-                (Expr { kind: ExprKind::List(items), span }, depth + 1)
+                (
+                    Expr {
+                        kind: ExprKind::List(items),
+                        span,
+                    },
+                    depth + 1,
+                )
             }
             Rule::call => {
                 let mut inner = pair.into_inner();
-                let Some(name) = inner.next().map(ident) else { return leaf(ExprKind::Error) };
+                let Some(name) = inner.next().map(ident) else {
+                    return leaf(ExprKind::Error);
+                };
                 let (args, depth) = self.exprs(inner);
-                (Expr { kind: ExprKind::Call(name, args), span }, depth + 1)
+                (
+                    Expr {
+                        kind: ExprKind::Call(name, args),
+                        span,
+                    },
+                    depth + 1,
+                )
             }
             _ => leaf(ExprKind::Error),
         }
@@ -486,7 +596,10 @@ impl Builder<'_> {
 }
 
 fn ident(pair: Pair<Rule>) -> Ident {
-    Ident { name: pair.as_str().to_string(), span: span_of(&pair) }
+    Ident {
+        name: pair.as_str().to_string(),
+        span: span_of(&pair),
+    }
 }
 
 fn unescape(s: &str) -> String {
@@ -512,7 +625,11 @@ fn doc_above(source: &str, at: usize) -> String {
     let before = &source[..at.min(source.len())];
     // The first reversed line is the text before `def` on its own line (usually empty).
     let mut lines: Vec<&str> = Vec::new();
-    for line in before.lines().rev().skip(usize::from(!before.ends_with('\n'))) {
+    for line in before
+        .lines()
+        .rev()
+        .skip(usize::from(!before.ends_with('\n')))
+    {
         match line.trim_start().strip_prefix("##") {
             Some(doc) => lines.push(doc.strip_prefix(' ').unwrap_or(doc)),
             None => break,
