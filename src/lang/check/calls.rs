@@ -463,7 +463,7 @@ impl<'a> Checker<'a> {
                     format!("`{name}` mixes {} and {}", x.unit, y.unit),
                 )
                 .label(format!("{} vs {}", x.unit, y.unit))
-                .help(super::expr::unit_hint(x.unit, y.unit));
+                .help(super::ops::unit_hint(x.unit, y.unit));
             }
             u
         };

@@ -7,7 +7,8 @@
 //! | --- | --- |
 //! | `header.rs` | prompt, length, params (+ overrides), people, definitions, recursion |
 //! | `stmt.rs` | statements, time blocks, loops, `if`, weights |
-//! | `expr.rs` | expressions, names, members, operators |
+//! | `expr.rs` | expressions, names, members, lists, `@` |
+//! | `ops.rs` | operators: kinds and units |
 //! | `calls.rs` | builtin and user function calls |
 //! | `time.rs` | time positions (`2s`, `50%`, `end - 1`) |
 //! | `builder.rs` | IR nodes: shapes, sharing, constant folding |
@@ -17,6 +18,7 @@ pub mod builtins;
 mod calls;
 mod expr;
 mod header;
+mod ops;
 mod stmt;
 mod time;
 pub mod units;
