@@ -28,6 +28,8 @@ enum Command {
     Bench(cli::bench::BenchCommand),
     /// Train the denoiser on a dataset built by `mprog data build`.
     Train(cli::train::TrainArgs),
+    /// Check `.mprog` programs and print their diagnostics.
+    Check(cli::check::CheckArgs),
 }
 
 fn main() -> miette::Result<()> {
@@ -39,6 +41,11 @@ fn main() -> miette::Result<()> {
         Command::Render(args) => cli::convert::render(args)?,
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
+        Command::Check(args) => {
+            if !cli::check::run(&args)? {
+                std::process::exit(1);
+            }
+        }
     }
     Ok(())
 }

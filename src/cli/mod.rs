@@ -5,3 +5,4 @@ pub mod data;
 pub mod train;
 pub mod convert;
 pub mod io;
+pub mod check;
