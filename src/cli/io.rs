@@ -45,7 +45,6 @@ pub fn write_outputs(outputs: &[PathBuf], people: &[Motion], meta: &Meta, title:
 }
 
 /// Output paths with `_i` inserted before the extension, for sample `i` of `count`.
-#[allow(dead_code)] // used by `gen --count` (next commit)
 pub fn numbered(outputs: &[PathBuf], i: usize, count: usize) -> Vec<PathBuf> {
     if count == 1 {
         return outputs.to_vec();
