@@ -17,7 +17,7 @@ enum Command {
     /// Print the joint names and aliases of the skeleton.
     Joints,
     /// Generate motions from text with the shipped model.
-    Gen(cli::gen::GenArgs),
+    Gen(cli::generate::GenArgs),
     /// Convert a motion file to other formats (by extension: bvh, npy, json, gif, png).
     Convert(cli::convert::ConvertArgs),
     /// Render a motion file as an animated GIF or a PNG strip.
@@ -38,7 +38,7 @@ fn main() -> miette::Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Joints => print_joints(),
-        Command::Gen(args) => cli::gen::run(args)?,
+        Command::Gen(args) => cli::generate::run(args)?,
         Command::Data(cmd) => cli::data::run(cmd)?,
         Command::Convert(args) => cli::convert::convert(args)?,
         Command::Render(args) => cli::convert::render(args)?,

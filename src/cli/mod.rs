@@ -6,4 +6,4 @@ pub mod train;
 pub mod convert;
 pub mod io;
 pub mod check;
-pub mod gen;
+pub mod generate;
