@@ -30,6 +30,8 @@ enum Command {
     Bench(cli::bench::BenchCommand),
     /// Train the denoiser on a dataset built by `mprog data build`.
     Train(cli::train::TrainArgs),
+    /// A program's error on a motion file, per statement, with an optional plot over time.
+    Score(cli::score::ScoreArgs),
     /// Check `.mprog` programs and print their diagnostics.
     Check(cli::check::CheckArgs),
 }
@@ -44,6 +46,7 @@ fn main() -> miette::Result<()> {
         Command::Render(args) => cli::convert::render(args)?,
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
+        Command::Score(args) => cli::score::run(args)?,
         Command::Check(args) => {
             if !cli::check::run(&args)? {
                 std::process::exit(1);

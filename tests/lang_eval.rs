@@ -596,3 +596,43 @@ fn wrong_shapes_are_reported_not_panicking() {
     let x = burn::tensor::Tensor::<5>::zeros([1, 1, F, 21, 3], &dev);
     assert!(prog.try_evaluate(x).is_err());
 }
+
+/// The per-frame trace of each statement averages (over the frames it applies to) to the
+/// statement's column of `per_statement`.
+#[test]
+fn traces_average_to_the_statement_errors() {
+    use burn::prelude::*;
+    let src = "length 12 frames\nalways { head.y > 1.9 m }\nat end { pelvis.z == 2 m }\nif head.y > 1.5 m { l_hand.y > 2 m }\n";
+    let program = mprog::lang::compile(src, "trace.mprog", &[]).expect("compiles");
+    let dev = Device::flex();
+    let frames = 12;
+    let mut data = Vec::new();
+    for t in 0..frames {
+        for j in 0..22 {
+            let y = 1.0 + 0.05 * t as f32 + 0.01 * j as f32;
+            data.extend_from_slice(&[0.1 * j as f32, y, 0.2 * t as f32]);
+        }
+    }
+    let joints = Tensor::<5>::from_data(TensorData::new(data, [1, 1, frames, 22, 3]), &dev);
+    let (eval, traces) = program.evaluate_traced(joints).expect("evaluates");
+    let per = eval
+        .per_statement
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap();
+    assert_eq!(traces.len(), 3);
+    assert_eq!(traces[1].frames, vec![frames - 1]);
+    for (i, t) in traces.iter().enumerate() {
+        let kept: Vec<f32> = t.values.iter().copied().filter(|v| !v.is_nan()).collect();
+        let mean = kept.iter().sum::<f32>() / kept.len().max(1) as f32;
+        assert!(
+            (mean - per[i]).abs() < 1e-5,
+            "statement {i}: {mean} vs {}",
+            per[i]
+        );
+    }
+    assert!(
+        traces[2].values.iter().any(|v| v.is_nan()),
+        "the if excludes early frames"
+    );
+}

@@ -30,7 +30,7 @@ pub struct CheckArgs {
     pub plain: bool,
 }
 
-fn parse_override(s: &str) -> Result<(String, f64), String> {
+pub fn parse_override(s: &str) -> Result<(String, f64), String> {
     let (k, v) = s
         .split_once('=')
         .ok_or_else(|| format!("expected NAME=VALUE, got `{s}`"))?;

@@ -6,4 +6,5 @@ pub mod convert;
 pub mod data;
 pub mod generate;
 pub mod io;
+pub mod score;
 pub mod train;

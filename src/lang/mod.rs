@@ -19,7 +19,7 @@ pub mod syntax;
 
 pub use check::{Header, ParamInfo, PersonInfo};
 pub use diag::{Diagnostic, Diagnostics, Severity};
-pub use eval::{EvalError, Evaluation};
+pub use eval::{EvalError, Evaluation, StatementTrace};
 pub use ir::CostEstimate;
 
 use burn::tensor::Tensor;
@@ -109,6 +109,14 @@ impl Program {
     /// Errors of a batch of motions, or why the tensor does not fit.
     pub fn try_evaluate(&self, joints: Tensor<5>) -> Result<Evaluation, EvalError> {
         eval::evaluate(&self.checked.ir, joints, &self.cache)
+    }
+
+    /// Errors of a batch of motions and every statement's error frame by frame.
+    pub fn evaluate_traced(
+        &self,
+        joints: Tensor<5>,
+    ) -> Result<(Evaluation, Vec<StatementTrace>), EvalError> {
+        eval::evaluate_traced(&self.checked.ir, joints, &self.cache)
     }
 
     /// The statements, in the column order of [`Evaluation::per_statement`].

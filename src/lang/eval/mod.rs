@@ -23,6 +23,17 @@ pub struct Evaluation {
     pub per_statement: Tensor<2>,
 }
 
+/// One statement's error frame by frame (for plots and the viewer's timeline).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StatementTrace {
+    /// Frames the statement applies to (its time block).
+    pub frames: Vec<usize>,
+    /// `[batch, frames.len()]` weighted error per frame (summed over loop lanes); NaN where
+    /// an `if` condition excludes the frame. Their mean over non-NaN frames is the
+    /// statement's column of [`Evaluation::per_statement`].
+    pub values: Vec<f32>,
+}
+
 /// Why a tensor cannot be evaluated.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EvalError {
@@ -119,6 +130,24 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
 
 /// Evaluates `ir` on joint positions `[batch, people, frames, 22, 3]`.
 pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evaluation, EvalError> {
+    evaluate_inner(ir, joints, cache, false).map(|(e, _)| e)
+}
+
+/// Like [`evaluate`], plus every statement's error frame by frame (read back to the host).
+pub fn evaluate_traced(
+    ir: &Ir,
+    joints: Tensor<5>,
+    cache: &IndexCache,
+) -> Result<(Evaluation, Vec<StatementTrace>), EvalError> {
+    evaluate_inner(ir, joints, cache, true)
+}
+
+fn evaluate_inner(
+    ir: &Ir,
+    joints: Tensor<5>,
+    cache: &IndexCache,
+    traced: bool,
+) -> Result<(Evaluation, Vec<StatementTrace>), EvalError> {
     let [batch, people, frames, nj, nc] = joints.dims();
     if people != ir.people || nj != NUM_JOINTS || nc != 3 || frames == 0 || batch == 0 {
         return Err(EvalError::BadShape {
@@ -206,8 +235,12 @@ pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evalua
         }
     }
     let mut columns = Vec::with_capacity(ir.statements.len());
+    let mut traces = Vec::new();
     for s in &ir.statements {
         columns.push(statement_error(ir, s, &values, idx, batch, &device));
+        if traced {
+            traces.push(statement_trace(ir, s, &values, batch, frames));
+        }
     }
     drop(guard);
     let per_statement = if columns.len() == 1 {
@@ -216,10 +249,57 @@ pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evalua
         Tensor::cat(columns, 1)
     };
     let total = per_statement.clone().sum_dim(1).reshape([batch]);
-    Ok(Evaluation {
-        total,
-        per_statement,
-    })
+    Ok((
+        Evaluation {
+            total,
+            per_statement,
+        },
+        traces,
+    ))
+}
+
+/// Frame-by-frame error of one statement, on the host.
+fn statement_trace(
+    ir: &Ir,
+    s: &Statement,
+    values: &[Option<Tensor<4>>],
+    batch: usize,
+    frames: usize,
+) -> StatementTrace {
+    let ts = ir.resolve_domain(s.domain, frames);
+    if ts.is_empty() {
+        return StatementTrace {
+            frames: ts,
+            values: Vec::new(),
+        };
+    }
+    let err = values[s.error].clone().expect("statement error is kept");
+    let mask = s.mask.and_then(|m| values[m].clone());
+    let lanes = err.dims()[2].max(mask.as_ref().map_or(1, |m| m.dims()[2]));
+    let factor = (s.weight * (s.lanes / lanes.max(1)) as f64) as f32;
+    let d = ts.len();
+    let host = |t: Tensor<4>| -> Vec<f32> {
+        // [b, |D| or 1, K or 1, 1] → [batch, |D|, K] → Σ over lanes → [batch, |D|]
+        let [b, f, k, _] = t.dims();
+        let t = t.reshape([b, f, k]).expand([batch, d, lanes]).sum_dim(2);
+        t.into_data()
+            .convert::<f32>()
+            .try_into_vec::<f32>()
+            .unwrap_or_default()
+    };
+    let (sum, covered) = match mask {
+        Some(m) => (host(err * m.clone()), Some(host(m))),
+        None => (host(err), None),
+    };
+    let values = sum
+        .iter()
+        .enumerate()
+        .map(|(i, v)| match &covered {
+            Some(c) if c[i] == 0.0 => f32::NAN,
+            _ => v * factor,
+        })
+        .collect();
+    StatementTrace { frames: ts, values }
 }
 
 /// For each node, the last node that reads it (statements count as reading at the end).
