@@ -9,6 +9,7 @@
 //! | motion data | [`formats`], [`features`], [`dataset`] | BVH / npy → [`motion::Motion`] → 263-dim HumanML3D features → training set |
 //! | model | [`model`] | features + text → denoiser, samplers, training |
 //! | language | [`lang`] | source → AST → checked IR → burn error graph |
+//! | solvers | [`solve`] | error graph + prompts → guided / optimised motions |
 //! | pictures | [`render`] | motions, curves → GIF / PNG |
 //!
 //! Conventions everywhere: HumanML3D 22-joint skeleton ([`skeleton`]), metres, Y up,
@@ -23,3 +24,4 @@ pub mod model;
 pub mod motion;
 pub mod render;
 pub mod skeleton;
+pub mod solve;

@@ -1,0 +1,274 @@
+//! The fused host path of the inner loops (guide, IK): `recover_from_ric` and the world
+//! placement as plain-array code with a hand-written backward (vector–Jacobian product),
+//! so each inner iteration costs one evaluation of the error graph and nothing else.
+//!
+//! Only the first 67 feature columns (root yaw velocity, root XZ velocity, root height and
+//! the ric block) reach the joints, so the fused path works on that "head" `[M, N, 67]`;
+//! the error's gradient with respect to every other column is exactly zero.
+//!
+//! Per motion (`a` is the root facing as a half-angle, frames t = 0..N−1):
+//! * `a_next[t] = Σ_{k≤t} yaw[k]`, `a[t] = a_next[t] − yaw[t]`;
+//! * root XZ `r[t] = Σ_{k<t} R(−2·a_next[k])·v[k]`, root y = column 3;
+//! * joint j ≥ 1: `R(−2·a[t])·ric_j[t] + (r_x, 0, r_z)`, where `R(θ)(x, z) = (x cos θ − z sin θ,
+//!   x sin θ + z cos θ)`.
+//!
+//! The backward runs these in reverse (reverse cumulative sums for the two prefix sums).
+//! Tests check forward and gradient against the burn graph ([`super::Decoder`]).
+
+use super::decode::Decoder;
+use super::place::Placement;
+use super::{MotionError, SolveError};
+use crate::features::layout::RIC;
+use crate::skeleton::NUM_JOINTS;
+use burn::prelude::*;
+
+/// Feature columns that reach the joints.
+pub const HEAD: usize = RIC.end;
+
+const J3: usize = NUM_JOINTS * 3;
+
+/// Plain-array `recover_from_ric` on de-normalised heads `[M, N, 67]` → joints `[M, N, 22, 3]`,
+/// and its backward. Keeps the rotation angles of the last forward for the backward.
+#[derive(Clone, Debug, Default)]
+pub struct HostFk {
+    frames: usize,
+    /// cos/sin of 2·a_next (root velocity turn) and of 2·a (ric turn), `[M, N]` each.
+    c1: Vec<f32>,
+    s1: Vec<f32>,
+    c0: Vec<f32>,
+    s0: Vec<f32>,
+}
+
+impl HostFk {
+    /// Joints of de-normalised heads; `joints` must hold `M·N·66` values.
+    pub fn forward(&mut self, head: &[f32], frames: usize, joints: &mut [f32]) {
+        let m = head.len() / (frames * HEAD);
+        assert_eq!(head.len(), m * frames * HEAD, "head length");
+        assert_eq!(joints.len(), m * frames * J3, "joints length");
+        self.frames = frames;
+        for v in [&mut self.c1, &mut self.s1, &mut self.c0, &mut self.s0] {
+            v.resize(m * frames, 0.0);
+        }
+        for mi in 0..m {
+            let (mut a_next, mut rx, mut rz) = (0.0f64, 0.0f64, 0.0f64);
+            for t in 0..frames {
+                let k = mi * frames + t;
+                let h = &head[k * HEAD..(k + 1) * HEAD];
+                let a_now = a_next;
+                a_next += h[0] as f64;
+                let (s1, c1) = (2.0 * a_next).sin_cos();
+                let (s0, c0) = (2.0 * a_now).sin_cos();
+                self.c1[k] = c1 as f32;
+                self.s1[k] = s1 as f32;
+                self.c0[k] = c0 as f32;
+                self.s0[k] = s0 as f32;
+                let out = &mut joints[k * J3..(k + 1) * J3];
+                out[0] = rx as f32;
+                out[1] = h[3];
+                out[2] = rz as f32;
+                let (c, s) = (c0 as f32, s0 as f32);
+                for j in 1..NUM_JOINTS {
+                    let r = &h[RIC.start + 3 * (j - 1)..RIC.start + 3 * j];
+                    out[3 * j] = r[0] * c - r[2] * s + rx as f32;
+                    out[3 * j + 1] = r[1];
+                    out[3 * j + 2] = r[0] * s + r[2] * c + rz as f32;
+                }
+                // The root moves after this frame by its velocity turned into the next facing.
+                let (vx, vz) = (h[1] as f64, h[2] as f64);
+                rx += vx * c1 - vz * s1;
+                rz += vx * s1 + vz * c1;
+            }
+        }
+    }
+
+    /// Gradient with respect to the de-normalised head of the last [`forward`](Self::forward),
+    /// given the gradient with respect to its joints. Overwrites `g_head`.
+    pub fn backward(&self, head: &[f32], g_joints: &[f32], g_head: &mut [f32]) {
+        let n = self.frames;
+        let m = head.len() / (n * HEAD);
+        assert_eq!(g_joints.len(), m * n * J3, "joint gradient length");
+        assert_eq!(g_head.len(), head.len(), "head gradient length");
+        for mi in 0..m {
+            // Reverse sweeps: Σ_{t'>t} of the root gradient, Σ_{t'≥t} of the a_next gradient.
+            let (mut g_rx_after, mut g_rz_after, mut g_anext_from) = (0.0f64, 0.0f64, 0.0f64);
+            for t in (0..n).rev() {
+                let k = mi * n + t;
+                let h = &head[k * HEAD..(k + 1) * HEAD];
+                let g = &g_joints[k * J3..(k + 1) * J3];
+                let gh = &mut g_head[k * HEAD..(k + 1) * HEAD];
+                // The root velocity of frame t moves the root of every later frame.
+                let (c1, s1) = (self.c1[k] as f64, self.s1[k] as f64);
+                let (vx, vz) = (h[1] as f64, h[2] as f64);
+                let (gsx, gsz) = (g_rx_after, g_rz_after);
+                gh[1] = (gsx * c1 + gsz * s1) as f32;
+                gh[2] = (-gsx * s1 + gsz * c1) as f32;
+                let g_theta1 = gsx * (-vx * s1 - vz * c1) + gsz * (vx * c1 - vz * s1);
+                // This frame's joints: ric turned by 2a, root XZ added to all 22.
+                let (c, s) = (self.c0[k], self.s0[k]);
+                let (mut g_rx, mut g_rz) = (g[0] as f64, g[2] as f64);
+                gh[3] = g[1];
+                let mut g_theta0 = 0.0f64;
+                for j in 1..NUM_JOINTS {
+                    let (gx, gy, gz) = (g[3 * j], g[3 * j + 1], g[3 * j + 2]);
+                    let base = RIC.start + 3 * (j - 1);
+                    let (x, z) = (h[base], h[base + 2]);
+                    gh[base] = gx * c + gz * s;
+                    gh[base + 1] = gy;
+                    gh[base + 2] = -gx * s + gz * c;
+                    g_theta0 += (gx * (-x * s - z * c) + gz * (x * c - z * s)) as f64;
+                    g_rx += gx as f64;
+                    g_rz += gz as f64;
+                }
+                g_rx_after += g_rx;
+                g_rz_after += g_rz;
+                // θ1 = 2·a_next[t], θ0 = 2·a[t] = 2·(a_next[t] − yaw[t]).
+                let g_anext = 2.0 * g_theta1 + 2.0 * g_theta0;
+                g_anext_from += g_anext;
+                gh[0] = (g_anext_from - 2.0 * g_theta0) as f32;
+            }
+        }
+    }
+}
+
+/// Error and gradient of normalised heads through the fused path: heads `[B·P, N, 67]`
+/// (normalised) → world joints → the error graph (burn, autodiff) → gradient back to the
+/// normalised heads.
+pub struct HostObjective<'a> {
+    error: &'a dyn MotionError,
+    device: Device,
+    batch: usize,
+    frames: usize,
+    mean: Vec<f32>,
+    std: Vec<f32>,
+    placements: Vec<Placement>,
+    fk: HostFk,
+    head: Vec<f32>,
+    joints: Vec<f32>,
+}
+
+impl<'a> HostObjective<'a> {
+    /// For `batch` samples of `frames` frames; `device` is where the error graph runs
+    /// (made autodiff here).
+    pub fn new(
+        error: &'a dyn MotionError,
+        decoder: &Decoder,
+        batch: usize,
+        frames: usize,
+        device: &Device,
+    ) -> Self {
+        HostObjective {
+            error,
+            device: device.clone().autodiff(),
+            batch,
+            frames,
+            mean: decoder.mean[..HEAD].to_vec(),
+            std: decoder.std[..HEAD].to_vec(),
+            placements: decoder.placements.clone(),
+            fk: HostFk::default(),
+            head: Vec::new(),
+            joints: Vec::new(),
+        }
+    }
+
+    /// World joints `[B, P, N, 22, 3]` (flat) of normalised heads.
+    pub fn world_joints(&mut self, head: &[f32]) -> &[f32] {
+        self.head.clear();
+        self.head.extend(head.chunks_exact(HEAD).flat_map(|row| {
+            row.iter()
+                .zip(&self.std)
+                .zip(&self.mean)
+                .map(|((x, s), m)| x * s + m)
+        }));
+        self.joints.resize(head.len() / HEAD * J3, 0.0);
+        self.fk.forward(&self.head, self.frames, &mut self.joints);
+        let per = self.frames * NUM_JOINTS;
+        for (i, chunk) in self.joints.chunks_exact_mut(per * 3).enumerate() {
+            let q = self.placements[i % self.placements.len()];
+            if q == Placement::IDENTITY {
+                continue;
+            }
+            let (c, s) = q.cos_sin();
+            for p in chunk.chunks_exact_mut(3) {
+                let (x, z) = (p[0], p[2]);
+                p[0] = c * x + s * z + q.x;
+                p[2] = -s * x + c * z + q.z;
+            }
+        }
+        &self.joints
+    }
+
+    /// Errors per sample `[B]`; writes `∂(Σ_b error_b)/∂head` (normalised) into `grad`.
+    /// Values are returned as computed (the caller checks them for NaN/Inf).
+    pub fn eval(&mut self, head: &[f32], grad: &mut [f32]) -> Result<Vec<f32>, SolveError> {
+        let people = self.placements.len();
+        self.world_joints(head);
+        let dims = [self.batch, people, self.frames, NUM_JOINTS, 3];
+        let j = Tensor::<5>::from_data(TensorData::new(self.joints.clone(), dims), &self.device)
+            .require_grad();
+        let e = self.error.error(j.clone());
+        check_shape(&e, self.batch)?;
+        let values = e
+            .clone()
+            .into_data()
+            .try_to_vec::<f32>()
+            .expect("f32 error");
+        let g_world = if e.is_tracked() {
+            let grads = e.sum().backward();
+            j.grad(&grads)
+                .map(|g| g.into_data().try_to_vec::<f32>().expect("f32 gradient"))
+        } else {
+            None
+        };
+        let Some(mut g) = g_world else {
+            grad.fill(0.0);
+            return Ok(values);
+        };
+        // Undo the placement (Rᵀ), then the FK, then the de-normalisation.
+        let per = self.frames * NUM_JOINTS * 3;
+        for (i, chunk) in g.chunks_exact_mut(per).enumerate() {
+            let q = self.placements[i % people];
+            if q == Placement::IDENTITY {
+                continue;
+            }
+            let (c, s) = q.cos_sin();
+            for p in chunk.chunks_exact_mut(3) {
+                let (gx, gz) = (p[0], p[2]);
+                p[0] = c * gx - s * gz;
+                p[2] = s * gx + c * gz;
+            }
+        }
+        self.fk.backward(&self.head, &g, grad);
+        for row in grad.chunks_exact_mut(HEAD) {
+            for (v, s) in row.iter_mut().zip(&self.std) {
+                *v *= s;
+            }
+        }
+        Ok(values)
+    }
+}
+
+/// Checks that an error tensor is `[batch]`.
+pub(crate) fn check_shape(e: &Tensor<1>, batch: usize) -> Result<(), SolveError> {
+    let d = e.dims();
+    if d[0] != batch {
+        return Err(SolveError::BadErrorShape {
+            got: d.to_vec(),
+            batch,
+        });
+    }
+    Ok(())
+}
+
+/// Copies the head columns of `[M, N, 263]` rows into `[M, N, 67]`.
+pub fn extract_head(full: &[f32], width: usize) -> Vec<f32> {
+    full.chunks_exact(width)
+        .flat_map(|row| row[..HEAD].iter().copied())
+        .collect()
+}
+
+/// Writes `[M, N, 67]` heads back into `[M, N, 263]` rows.
+pub fn insert_head(full: &mut [f32], width: usize, head: &[f32]) {
+    for (row, h) in full.chunks_exact_mut(width).zip(head.chunks_exact(HEAD)) {
+        row[..HEAD].copy_from_slice(h);
+    }
+}

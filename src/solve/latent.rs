@@ -1,0 +1,201 @@
+//! PMG's latent-noise optimisation (reference-algorithms §1.1–1.3): the DDIM chain
+//! (η = 0, 100 steps, CFG 2.5 with both passes batched) is a deterministic function
+//! x̂ = D(z) of the initial noise z; Adam minimises E(D(z)) over z with the gradient
+//! through the whole chain (frozen denoiser: no parameter gradients, dropout off).
+//!
+//! ```text
+//! z ← x_T (seeded);  for it in 0..iterations:
+//!     x̂ ← DDIM(z);  record E(x̂);  if it is not the last: z ← Adam(z, ∂E/∂z)
+//! return x̂ of the last forward (after iterations − 1 updates), as PMG does
+//! ```
+//!
+//! Relaxation (PMG §3.4, simple form): with [`Relax::RigidXz`] every (sample, person) also
+//! gets a rigid horizontal transform (yaw, x, z), applied in its own frame before its
+//! placement and optimised jointly with z by its own Adam. This is PMG's "relax the goal,
+//! then move the motion onto the true goal" for goals that only care about positions up to
+//! a horizontal rigid motion (planes, lines, point pairs), done in one loop instead of
+//! relaxation rounds.
+//!
+//! Memory: the graph of the whole chain (steps × 2 CFG passes) is kept for one backward;
+//! `peak_rss_mib` in the tests/examples measures it.
+
+use super::adam::Adam;
+use super::decode::RigidTensors;
+use super::place::Placement;
+use super::request::{Phase, Progress};
+use super::run::{Ctx, Outcome, ensure_finite, host, mean};
+use super::{SolveError, host::check_shape};
+use crate::model::sampler::{Condition, ddim_step, guided_x0};
+use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use crate::model::{Denoiser, Mdm};
+use burn::prelude::*;
+
+/// Whether the motion may move rigidly in the horizontal plane while it is optimised.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Relax {
+    /// No relaxation.
+    None,
+    /// A yaw and an XZ translation per (sample, person), optimised with z.
+    RigidXz,
+}
+
+/// Settings of [`super::Solver::Latent`]; defaults are PMG's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LatentConfig {
+    /// DDIM steps (100).
+    pub ddim_steps: usize,
+    /// Forward passes (100; the last one's sample is returned).
+    pub iterations: usize,
+    /// Adam learning rate on z (0.005, constant).
+    pub lr: f64,
+    /// Relaxation.
+    pub relax: Relax,
+    /// Adam learning rate of the relaxation's yaw (rad) and translation (m).
+    pub relax_lr: f64,
+}
+
+impl Default for LatentConfig {
+    fn default() -> Self {
+        LatentConfig {
+            ddim_steps: 100,
+            iterations: 100,
+            lr: 0.005,
+            relax: Relax::None,
+            relax_lr: 0.02,
+        }
+    }
+}
+
+impl LatentConfig {
+    pub(crate) fn validate(&self) -> Result<(), SolveError> {
+        if !(1..=DIFFUSION_STEPS).contains(&self.ddim_steps) || self.iterations == 0 {
+            return Err(SolveError::Invalid(format!(
+                "latent: {} DDIM steps and {} iterations; use 1..={DIFFUSION_STEPS} steps and ≥ 1 iteration",
+                self.ddim_steps, self.iterations
+            )));
+        }
+        if !(self.lr.is_finite() && self.lr >= 0.0 && self.relax_lr.is_finite()) {
+            return Err(SolveError::Invalid(
+                "latent: learning rates must be finite".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The DDIM (η = 0) chain from `z`: on an autodiff device with a frozen model it is
+/// differentiable with respect to `z`.
+pub fn ddim_chain(
+    den: &impl Denoiser,
+    schedule: &NoiseSchedule,
+    z: Tensor<3>,
+    cond: &Condition,
+) -> Tensor<3> {
+    let mut x = z;
+    for i in (0..schedule.len()).rev() {
+        let x0 = guided_x0(den, x.clone(), schedule.timesteps[i], cond);
+        x = ddim_step(schedule, i, x, x0);
+    }
+    x
+}
+
+/// A copy of the denoiser on `autodiff` whose parameters take no gradient and whose
+/// dropout is off: gradients flow through it to its inputs only.
+pub fn frozen(model: &Mdm, autodiff: &Device) -> Mdm {
+    model.clone().fork(autodiff).freeze()
+}
+
+/// Runs the optimisation.
+pub(crate) fn run(
+    ctx: &Ctx,
+    cfg: &LatentConfig,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Outcome, SolveError> {
+    let ad = ctx.device.clone().autodiff();
+    let model = frozen(ctx.prior.model, &ad);
+    let cond = ctx.condition(&ad);
+    let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS).respaced(cfg.ddim_steps);
+    let dims = ctx.dims();
+    let m = ctx.motions();
+    let mut z = ctx.initial_noise();
+    let mut adam = Adam::new(z.len(), cfg.lr);
+    let relax = cfg.relax == Relax::RigidXz;
+    // [yaw; x; z] × motions.
+    let mut rigid = vec![0.0f32; 3 * m];
+    let mut adam_rigid = Adam::new(rigid.len(), cfg.relax_lr);
+    let mut trace = Vec::with_capacity(cfg.iterations);
+    let mut last = Vec::new();
+    for it in 0..cfg.iterations {
+        let at = || format!("iteration {}/{}", it + 1, cfg.iterations);
+        let zt = Tensor::<3>::from_data(TensorData::new(z.clone(), dims), &ad).require_grad();
+        let x = ddim_chain(&model, &schedule, zt.clone(), &cond);
+        let rt = relax.then(|| {
+            let part = |k: usize| {
+                Tensor::<2>::from_data(
+                    TensorData::new(
+                        rigid[k * m..(k + 1) * m].to_vec(),
+                        [ctx.samples, ctx.people],
+                    ),
+                    &ad,
+                )
+                .require_grad()
+            };
+            RigidTensors {
+                yaw: part(0),
+                x: part(1),
+                z: part(2),
+            }
+        });
+        let e = ctx.error.error(ctx.decoder.joints(x.clone(), rt.as_ref()));
+        check_shape(&e, ctx.samples)?;
+        let values = e
+            .clone()
+            .into_data()
+            .try_to_vec::<f32>()
+            .expect("f32 error");
+        ensure_finite(&values, "latent", "error", at)?;
+        last = host(x.detach());
+        progress(Progress {
+            phase: Phase::Optimising,
+            done: it + 1,
+            total: cfg.iterations,
+            error: Some(mean(&values)),
+        });
+        trace.push(values);
+        if it + 1 == cfg.iterations || !e.is_tracked() {
+            break;
+        }
+        let grads = e.sum().backward();
+        let gz = zt
+            .grad(&grads)
+            .map(host)
+            .unwrap_or_else(|| vec![0.0; z.len()]);
+        ensure_finite(&gz, "latent", "gradient", at)?;
+        adam.step(&mut z, &gz);
+        if let Some(r) = rt {
+            let mut g = Vec::with_capacity(3 * m);
+            for t in [&r.yaw, &r.x, &r.z] {
+                match t.grad(&grads) {
+                    Some(v) => g.extend(v.into_data().try_to_vec::<f32>().expect("f32")),
+                    None => g.extend(std::iter::repeat_n(0.0, m)),
+                }
+            }
+            ensure_finite(&g, "latent", "gradient", at)?;
+            adam_rigid.step(&mut rigid, &g);
+        }
+    }
+    let relax = relax.then(|| {
+        (0..m)
+            .map(|i| Placement {
+                yaw: rigid[i],
+                x: rigid[m + i],
+                z: rigid[2 * m + i],
+            })
+            .collect()
+    });
+    Ok(Outcome {
+        x: last,
+        relax,
+        trace,
+    })
+}

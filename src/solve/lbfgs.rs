@@ -1,0 +1,177 @@
+//! InterControl-style IK guidance (reference-algorithms §3.2, `--use_posterior`): at every
+//! DDPM step a **fresh** L-BFGS (history 10, ≤ 4 inner iterations and ≤ 5 evaluations per
+//! call, strong-Wolfe line search, learning rate 1) minimises the error of the posterior
+//! mean μ_t, decoded as if it were a clean motion; its `step` is called k_first times on
+//! steps t ≥ T_s and k_last times on the last T_s steps; then x_{t−1} = μ_t + σ_t·ε.
+//!
+//! The objective is the [`MotionError`](super::MotionError) of the decoded μ through the burn
+//! graph (InterControl's own loss is an MSE to target joints; any error works here). burn's
+//! `LBFGS` (burn-optim, a port of PyTorch's) does the optimisation.
+//!
+//! Defaults: k_first = 2, k_last = 10, T_s = 10 (InterControl's parser defaults; its
+//! two-person sampler hard-codes k_first = 1, its README evaluation uses 5).
+
+use super::SolveError;
+use super::host::check_shape;
+use super::request::{Phase, Progress};
+use super::run::{Ctx, Outcome, ensure_finite, host, mean};
+use crate::model::sampler::{guided_x0, posterior_mean};
+use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use burn::module::Param;
+use burn::optim::{GradientsParams, LBFGSConfig, LineSearchFn};
+use burn::prelude::*;
+use std::cell::Cell;
+
+/// Settings of [`super::Solver::Lbfgs`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LbfgsConfig {
+    /// DDPM steps (1000 = full chain).
+    pub steps: usize,
+    /// `step` calls per denoising step before the last `late_steps` (2).
+    pub k_first: usize,
+    /// `step` calls on each of the last `late_steps` steps (10).
+    pub k_last: usize,
+    /// T_s = 10.
+    pub late_steps: usize,
+    /// History size (10).
+    pub history: usize,
+    /// Inner iterations per `step` call (4).
+    pub max_iter: usize,
+    /// Learning rate (1.0).
+    pub lr: f64,
+}
+
+impl Default for LbfgsConfig {
+    fn default() -> Self {
+        LbfgsConfig {
+            steps: DIFFUSION_STEPS,
+            k_first: 2,
+            k_last: 10,
+            late_steps: 10,
+            history: 10,
+            max_iter: 4,
+            lr: 1.0,
+        }
+    }
+}
+
+impl LbfgsConfig {
+    pub(crate) fn validate(&self) -> Result<(), SolveError> {
+        if !(1..=DIFFUSION_STEPS).contains(&self.steps)
+            || self.history == 0
+            || self.max_iter == 0
+            || !(self.lr.is_finite() && self.lr > 0.0)
+        {
+            return Err(SolveError::Invalid(format!(
+                "lbfgs: need 1..={DIFFUSION_STEPS} steps, history ≥ 1, max_iter ≥ 1 and a positive learning rate"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The optimised variable: μ_t as a one-parameter module.
+#[derive(Module, Debug)]
+struct Mu {
+    x: Param<Tensor<3>>,
+}
+
+/// Runs the guided chain.
+pub(crate) fn run(
+    ctx: &Ctx,
+    cfg: &LbfgsConfig,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Outcome, SolveError> {
+    let den = ctx.denoiser();
+    let ad = ctx.device.clone().autodiff();
+    let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS).respaced(cfg.steps);
+    let cond = ctx.condition(&ctx.device);
+    let mut noise = ctx.step_noise();
+    let dims = ctx.dims();
+    let n = schedule.len();
+    let optimiser = LBFGSConfig::new()
+        .with_history_size(cfg.history)
+        .with_max_iter(cfg.max_iter)
+        .with_line_search_fn(LineSearchFn::StrongWolfe);
+    let mut x = ctx.initial_tensor(&ctx.device);
+    let mut trace = Vec::with_capacity(n);
+    for i in (0..n).rev() {
+        let x0 = guided_x0(&den, x.clone(), schedule.timesteps[i], &cond);
+        let mu = posterior_mean(&schedule, i, x, x0);
+        let k = if i < cfg.late_steps {
+            cfg.k_last
+        } else {
+            cfg.k_first
+        };
+        let at = || format!("denoising step {}/{n}", n - i);
+        let mut module = Mu {
+            x: Param::from_tensor(Tensor::from_data(mu.into_data(), &ad).require_grad()),
+        };
+        let mut lbfgs = optimiser.init();
+        let bad: Cell<Option<SolveError>> = Cell::new(None);
+        let mut last: Vec<f32> = Vec::new();
+        for _ in 0..k {
+            let mut closure = |m: Mu| -> (f64, GradientsParams) {
+                let e = ctx.error.error(ctx.decoder.joints(m.x.val(), None));
+                let mut grads = GradientsParams::new();
+                if let Err(err) = check_shape(&e, ctx.samples) {
+                    bad.set(Some(err));
+                    grads.register(m.x.id, Tensor::<3>::zeros(dims, &ctx.device));
+                    return (f64::NAN, grads);
+                }
+                last = e
+                    .clone()
+                    .into_data()
+                    .try_to_vec::<f32>()
+                    .expect("f32 error");
+                let total = e.sum();
+                let value = total.clone().into_scalar::<f64>();
+                if !value.is_finite() {
+                    bad.set(Some(SolveError::NonFinite {
+                        solver: "lbfgs",
+                        what: "error",
+                        at: at(),
+                    }));
+                }
+                if total.is_tracked() {
+                    grads = GradientsParams::from_grads(total.backward(), &m);
+                }
+                if grads.get::<3>(m.x.id).is_none() {
+                    grads.register(m.x.id, Tensor::<3>::zeros(dims, &ctx.device));
+                }
+                (value, grads)
+            };
+            let (next, loss) = lbfgs.step(cfg.lr, module, &mut closure);
+            module = next;
+            if let Some(err) = bad.take() {
+                return Err(err);
+            }
+            ensure_finite(&[loss as f32], "lbfgs", "error", at)?;
+        }
+        let mu = Tensor::<3>::from_data(module.x.val().detach().into_data(), &ctx.device);
+        let values = if k > 0 {
+            ensure_finite(&last, "lbfgs", "error", at)?;
+            trace.push(last.clone());
+            Some(mean(&last))
+        } else {
+            None
+        };
+        ensure_finite(&host(mu.clone()), "lbfgs", "sample", at)?;
+        x = if i > 0 {
+            mu + noise.tensor(dims, &ctx.device) * schedule.posterior(i).variance.sqrt()
+        } else {
+            mu
+        };
+        progress(Progress {
+            phase: Phase::Sampling,
+            done: n - i,
+            total: n,
+            error: values,
+        });
+    }
+    Ok(Outcome {
+        x: host(x),
+        relax: None,
+        trace,
+    })
+}

@@ -1,0 +1,113 @@
+//! Solvers: steer the motion diffusion model so its samples minimise a differentiable
+//! error on joint positions ([`MotionError`]), for one or many people.
+//!
+//! The solvers know nothing of the `.mprog` language: anything that maps joints
+//! `[batch, people, frames, 22, 3]` (metres, Y up, world placement applied) to an error per
+//! sample `[batch]` can drive them. They share the denoiser ([`Prior`]), the seeded noise,
+//! the world placement of each person ([`Placement`]) and `recover_from_ric`.
+//!
+//! | solver | module | what is optimised | reference |
+//! | --- | --- | --- | --- |
+//! | [`Solver::Guide`] | [`guide`] | posterior mean μ_t, K gradient steps at every DDPM step | OmniControl spatial guidance (reference-algorithms §2.2) |
+//! | [`Solver::Latent`] | [`latent`] | initial noise z of a DDIM-100 chain, Adam through the chain | PMG (§1.1–1.3) |
+//! | [`Solver::Ik`] | [`ik`] | the unguided sample's normalised features, Adam, optional smoothness | PMG's IK / IK+Reg baselines (§5.2) |
+//! | [`Solver::Lbfgs`] | [`lbfgs`] | posterior mean μ_t, fresh L-BFGS at every DDPM step | InterControl IK guidance (§3.2) |
+//! | [`Solver::Plain`] | — | nothing (the unguided sampler, for comparisons) | — |
+//!
+//! Many people: P prompts are sampled as one batch of B·P motions (sample-major: index
+//! `b·P + p`, CFG doubles it to 2·B·P), each person's joints are moved into the world by
+//! its [`Placement`] (two people: InterControl's facing placement 2 m apart; more: a circle)
+//! and the error sees `[B, P, N, 22, 3]`.
+//!
+//! ```no_run
+//! use burn::prelude::*;
+//! use mprog::model::ModelBundle;
+//! use mprog::solve::{Prior, SolveRequest, Solver, GuideConfig, solve};
+//! # fn demo() -> Result<(), Box<dyn std::error::Error>> {
+//! let device = Device::flex();
+//! let bundle = ModelBundle::load(&mprog::model::weights::default_model_dir(), &device)?;
+//! // Pelvis at (0, 0.9, 3) on the last frame.
+//! let error = |j: Tensor<5>| {
+//!     let [b, _, n, _, _] = j.dims();
+//!     let target = Tensor::<1>::from_floats([0.0, 0.9, 3.0], &j.device()).reshape([1, 1, 1, 1, 3]);
+//!     let d = j.narrow(2, n - 1, 1).narrow(3, 0, 1) - target;
+//!     d.square().sum_dim(4).sqrt().reshape([b])
+//! };
+//! let req = SolveRequest::new(vec!["a person walks forward".into()], 120, 7, Solver::Guide(GuideConfig::default()));
+//! let out = solve(&Prior::from_bundle(&bundle), &req, &error, &device, |_| {})?;
+//! println!("error {:?} in {:.1} s", out.error, out.seconds);
+//! # Ok(()) }
+//! ```
+
+pub mod adam;
+mod decode;
+pub mod guide;
+pub mod host;
+pub mod ik;
+pub mod latent;
+pub mod lbfgs;
+mod place;
+mod request;
+mod run;
+
+#[cfg(test)]
+mod tests;
+
+pub use decode::{Decoder, RigidTensors};
+pub use guide::{GuideConfig, StepRule, VarianceRule};
+pub use ik::IkConfig;
+pub use latent::{LatentConfig, Relax};
+pub use lbfgs::LbfgsConfig;
+pub use place::Placement;
+pub use request::{Phase, Prior, Progress, SolveRequest, SolveResult, Solver};
+pub use run::solve;
+
+use burn::tensor::Tensor;
+
+/// Differentiable error of a batch of motions: joints `[batch, people, frames, 22, 3]`
+/// (metres, Y up, world placement applied) → total error per sample `[batch]`.
+///
+/// Solvers minimise it. It must be built from burn tensor ops on the input's device so
+/// gradients reach the joints; it is called on plain and on autodiff devices. Closures
+/// `Fn(Tensor<5>) -> Tensor<1>` implement it.
+pub trait MotionError {
+    /// `[batch]` error of each sample.
+    fn error(&self, joints: Tensor<5>) -> Tensor<1>;
+}
+
+impl<F: Fn(Tensor<5>) -> Tensor<1>> MotionError for F {
+    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
+        self(joints)
+    }
+}
+
+/// Why a solve failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    /// The request cannot be run (no prompt, bad length, bad settings).
+    #[error("{0}")]
+    Invalid(String),
+    /// The error or its gradient became NaN/Inf.
+    #[error(
+        "{solver}: the {what} became NaN or infinite at {at}; the error function or the step size is unstable there"
+    )]
+    NonFinite {
+        /// Which solver.
+        solver: &'static str,
+        /// "error", "gradient" or "sample".
+        what: &'static str,
+        /// Where: the denoising step or iteration, human-readable.
+        at: String,
+    },
+    /// The error function returned a tensor of the wrong shape.
+    #[error("the error function returned shape {got:?}; expected [{batch}] (one error per sample)")]
+    BadErrorShape {
+        /// What it returned.
+        got: Vec<usize>,
+        /// Samples in the batch.
+        batch: usize,
+    },
+    /// Turning features into joints failed.
+    #[error(transparent)]
+    Features(#[from] crate::features::FeatureError),
+}

@@ -1,0 +1,159 @@
+//! The common solver API: what to solve ([`SolveRequest`], [`Solver`]), with which model
+//! ([`Prior`]), what comes back ([`SolveResult`]) and progress reports ([`Progress`]).
+
+use super::guide::GuideConfig;
+use super::ik::IkConfig;
+use super::latent::LatentConfig;
+use super::lbfgs::LbfgsConfig;
+use super::place::Placement;
+use crate::model::sampler::SamplerKind;
+use crate::model::text::Vocabulary;
+use crate::model::{Mdm, ModelBundle};
+use crate::motion::Motion;
+
+/// The motion prior the solvers steer: denoiser, vocabulary and normalisation statistics.
+#[derive(Clone, Copy, Debug)]
+pub struct Prior<'a> {
+    /// The denoiser (any mode; solvers make their own inference or frozen copies).
+    pub model: &'a Mdm,
+    /// Its text vocabulary.
+    pub vocab: &'a Vocabulary,
+    /// `[263]` feature mean.
+    pub mean: &'a [f32],
+    /// `[263]` feature std.
+    pub std: &'a [f32],
+    /// Longest motion the model generates (frames).
+    pub max_frames: usize,
+}
+
+impl<'a> Prior<'a> {
+    /// The prior of a loaded bundle.
+    pub fn from_bundle(bundle: &'a ModelBundle) -> Self {
+        Prior {
+            model: &bundle.model,
+            vocab: &bundle.vocab,
+            mean: &bundle.mean,
+            std: &bundle.std,
+            max_frames: bundle.config.max_frames,
+        }
+    }
+}
+
+/// Which solver, with its settings.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Solver {
+    /// The unguided sampler (no optimisation), for comparisons.
+    Plain(SamplerKind),
+    /// OmniControl-style guidance of μ_t ([`super::guide`]).
+    Guide(GuideConfig),
+    /// PMG's optimisation of the initial noise through DDIM ([`super::latent`]).
+    Latent(LatentConfig),
+    /// Direct optimisation of the unguided sample ([`super::ik`]); `ik` or `ik-reg`.
+    Ik(IkConfig),
+    /// InterControl-style L-BFGS on μ_t ([`super::lbfgs`]).
+    Lbfgs(LbfgsConfig),
+}
+
+impl Solver {
+    /// Short name: `plain`, `guide`, `latent`, `ik`, `ik-reg` or `lbfgs`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Solver::Plain(_) => "plain",
+            Solver::Guide(_) => "guide",
+            Solver::Latent(_) => "latent",
+            Solver::Ik(c) if c.smoothness > 0.0 => "ik-reg",
+            Solver::Ik(_) => "ik",
+            Solver::Lbfgs(_) => "lbfgs",
+        }
+    }
+
+    /// The solver of that [`name`](Self::name) with its default settings.
+    pub fn by_name(name: &str) -> Option<Solver> {
+        Some(match name {
+            "plain" => Solver::Plain(SamplerKind::Ddpm(1000)),
+            "guide" => Solver::Guide(GuideConfig::default()),
+            "latent" => Solver::Latent(LatentConfig::default()),
+            "ik" => Solver::Ik(IkConfig::ik()),
+            "ik-reg" => Solver::Ik(IkConfig::ik_reg()),
+            "lbfgs" => Solver::Lbfgs(LbfgsConfig::default()),
+            _ => return None,
+        })
+    }
+}
+
+/// What to solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolveRequest {
+    /// One prompt per person (P = its length).
+    pub prompts: Vec<String>,
+    /// Frames per motion (20 fps).
+    pub frames: usize,
+    /// Seed of every random number (initial and step noise).
+    pub seed: u64,
+    /// Independent samples B solved side by side (each with its own noise).
+    pub samples: usize,
+    /// Classifier-free guidance scale of the text (2.5 in MDM/PMG/OmniControl).
+    pub guidance_scale: f32,
+    /// World placement per person; `None`: [`Placement::defaults`] 2 m apart.
+    pub placements: Option<Vec<Placement>>,
+    /// The solver and its settings.
+    pub solver: Solver,
+}
+
+impl SolveRequest {
+    /// One sample, CFG 2.5, default placements.
+    pub fn new(prompts: Vec<String>, frames: usize, seed: u64, solver: Solver) -> Self {
+        SolveRequest {
+            prompts,
+            frames,
+            seed,
+            samples: 1,
+            guidance_scale: 2.5,
+            placements: None,
+            solver,
+        }
+    }
+}
+
+/// What a solve produced.
+#[derive(Clone, Debug)]
+pub struct SolveResult {
+    /// `[sample][person]` world joint positions (placement and relaxation applied).
+    pub motions: Vec<Vec<Motion>>,
+    /// `[B, P, N, 263]` de-normalised features in the model's canonical frame.
+    pub features: Vec<f32>,
+    /// `[sample][person]` the rigid transform taking the canonical motion to the world
+    /// (the placement, composed with the relaxation when the solver relaxes).
+    pub placements: Vec<Vec<Placement>>,
+    /// `[B]` error of the returned motions.
+    pub error: Vec<f32>,
+    /// Error per sample after each denoising step (guide, lbfgs) or before each iteration
+    /// (latent, ik; entry 0 is the unguided sample's error). Empty for `plain`.
+    pub trace: Vec<Vec<f32>>,
+    /// Wall-clock seconds of the whole solve.
+    pub seconds: f64,
+    /// Words of each person's prompt the model does not know (ignored).
+    pub unknown_words: Vec<Vec<String>>,
+}
+
+/// What a solver is doing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// Running a denoising chain (guided or not).
+    Sampling,
+    /// Optimising (latent, ik iterations).
+    Optimising,
+}
+
+/// A progress report: `done` of `total` units of `phase`, with the latest mean error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Progress {
+    /// The phase.
+    pub phase: Phase,
+    /// Units done.
+    pub done: usize,
+    /// Units in the phase.
+    pub total: usize,
+    /// Mean error over samples after this unit, when the unit computes it.
+    pub error: Option<f32>,
+}

@@ -1,0 +1,307 @@
+//! [`solve`]: validates a request, builds what every solver shares ([`Ctx`]: condition,
+//! noise, decoder), runs the chosen solver and turns its normalised samples into world
+//! motions, features and final errors.
+
+use super::decode::Decoder;
+use super::host::check_shape;
+use super::place::{DEFAULT_SPACING, Placement};
+use super::request::{Phase, Prior, Progress, SolveRequest, SolveResult, Solver};
+use super::{MotionError, SolveError, guide, ik, latent, lbfgs};
+use crate::features::{FEATURE_DIM, recover_from_ric};
+use crate::model::Mdm;
+use crate::model::noise::NoiseSource;
+use crate::model::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
+use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use crate::motion::Motion;
+use crate::skeleton::NUM_JOINTS;
+use burn::prelude::*;
+use std::time::Instant;
+
+/// Seed offset of DDPM's per-step noise (the same as `model::generate`, so an unguided
+/// `plain` solve reproduces `generate`).
+const STEP_NOISE: u64 = 0x5DEE_CE66;
+
+/// Everything a solver needs besides its own settings.
+pub(crate) struct Ctx<'a> {
+    pub prior: Prior<'a>,
+    pub error: &'a dyn MotionError,
+    /// Plain (non-autodiff) device.
+    pub device: Device,
+    /// Samples B.
+    pub samples: usize,
+    /// People P.
+    pub people: usize,
+    /// Frames N.
+    pub frames: usize,
+    pub seed: u64,
+    pub guidance_scale: f32,
+    /// One prompt per motion, sample-major (`b·P + p`).
+    pub prompts: Vec<String>,
+    pub decoder: Decoder,
+}
+
+/// What a solver hands back: normalised samples and, when it relaxes, a transform per motion.
+pub(crate) struct Outcome {
+    /// `[B·P, N, 263]` normalised.
+    pub x: Vec<f32>,
+    /// Per motion, applied before the placement.
+    pub relax: Option<Vec<Placement>>,
+    pub trace: Vec<Vec<f32>>,
+}
+
+impl Ctx<'_> {
+    /// Motions in the batch (B·P).
+    pub fn motions(&self) -> usize {
+        self.samples * self.people
+    }
+
+    /// `[B·P, N, 263]`.
+    pub fn dims(&self) -> [usize; 3] {
+        [self.motions(), self.frames, FEATURE_DIM]
+    }
+
+    /// The tokenised prompts (CFG-doubled) on `device`.
+    pub fn condition(&self, device: &Device) -> Condition {
+        let p: Vec<&str> = self.prompts.iter().map(String::as_str).collect();
+        Condition::new(self.prior.vocab, &p, self.guidance_scale, device)
+    }
+
+    /// Host values of the initial noise x_T.
+    pub fn initial_noise(&self) -> Vec<f32> {
+        NoiseSource::new(self.seed).values(self.dims().iter().product())
+    }
+
+    /// Initial noise as a tensor on `device`.
+    pub fn initial_tensor(&self, device: &Device) -> Tensor<3> {
+        Tensor::from_data(TensorData::new(self.initial_noise(), self.dims()), device)
+    }
+
+    /// DDPM's per-step noise stream.
+    pub fn step_noise(&self) -> NoiseSource {
+        NoiseSource::new(self.seed ^ STEP_NOISE)
+    }
+
+    /// Inference copy of the denoiser (no autodiff, dropout off).
+    pub fn denoiser(&self) -> Mdm {
+        self.prior.model.valid()
+    }
+
+    /// The unguided chain of `kind` from the initial noise.
+    pub fn sample_plain(&self, kind: SamplerKind, progress: &mut dyn FnMut(Progress)) -> Tensor<3> {
+        let den = self.denoiser();
+        let schedule = schedule_for(&NoiseSchedule::cosine(DIFFUSION_STEPS), kind);
+        let cond = self.condition(&self.device);
+        let mut noise = self.step_noise();
+        sample_chain(
+            &den,
+            &schedule,
+            kind,
+            self.initial_tensor(&self.device),
+            &cond,
+            &mut noise,
+            |done, total| {
+                progress(Progress {
+                    phase: Phase::Sampling,
+                    done,
+                    total,
+                    error: None,
+                })
+            },
+        )
+    }
+}
+
+/// Host copy of a tensor.
+pub(crate) fn host(t: Tensor<3>) -> Vec<f32> {
+    t.into_data().try_to_vec::<f32>().expect("f32 tensor")
+}
+
+/// Mean of per-sample errors (for progress reports).
+pub(crate) fn mean(v: &[f32]) -> f32 {
+    v.iter().sum::<f32>() / v.len().max(1) as f32
+}
+
+/// Fails with [`SolveError::NonFinite`] when any value is NaN/Inf.
+pub(crate) fn ensure_finite(
+    values: &[f32],
+    solver: &'static str,
+    what: &'static str,
+    at: impl FnOnce() -> String,
+) -> Result<(), SolveError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SolveError::NonFinite {
+            solver,
+            what,
+            at: at(),
+        })
+    }
+}
+
+fn validate(prior: &Prior, req: &SolveRequest) -> Result<Vec<Placement>, SolveError> {
+    let bad = |m: String| Err(SolveError::Invalid(m));
+    if req.prompts.is_empty() {
+        return bad("no prompt: give one prompt per person".into());
+    }
+    if req.samples == 0 {
+        return bad("0 samples asked; ask for at least 1".into());
+    }
+    if req.frames < 2 || req.frames > prior.max_frames {
+        return bad(format!(
+            "{} frames asked; this model generates 2..={} frames ({:.1} s at 20 fps)",
+            req.frames,
+            prior.max_frames,
+            prior.max_frames as f32 / 20.0
+        ));
+    }
+    if !(req.guidance_scale.is_finite()) {
+        return bad("the classifier-free guidance scale must be a finite number".into());
+    }
+    let placements = match &req.placements {
+        Some(p) if p.len() != req.prompts.len() => {
+            return bad(format!(
+                "{} placements for {} people; give one per person",
+                p.len(),
+                req.prompts.len()
+            ));
+        }
+        Some(p) => p.clone(),
+        None => Placement::defaults(req.prompts.len(), DEFAULT_SPACING),
+    };
+    if placements
+        .iter()
+        .any(|q| !(q.yaw.is_finite() && q.x.is_finite() && q.z.is_finite()))
+    {
+        return bad("a placement is not finite".into());
+    }
+    match &req.solver {
+        Solver::Plain(k) => check_kind(*k)?,
+        Solver::Guide(c) => c.validate()?,
+        Solver::Latent(c) => c.validate()?,
+        Solver::Ik(c) => c.validate()?,
+        Solver::Lbfgs(c) => c.validate()?,
+    }
+    Ok(placements)
+}
+
+/// Sampler kinds need at least one step and at most the base schedule's 1000.
+pub(crate) fn check_kind(kind: SamplerKind) -> Result<(), SolveError> {
+    match kind {
+        SamplerKind::Ddim(k) | SamplerKind::Ddpm(k) if (1..=DIFFUSION_STEPS).contains(&k) => Ok(()),
+        _ => Err(SolveError::Invalid(format!(
+            "{kind:?}: a chain needs 1..={DIFFUSION_STEPS} steps"
+        ))),
+    }
+}
+
+/// Solves `req` with the prior, minimising `error`. `device` is a plain (non-autodiff)
+/// device; autodiff copies are made where a solver needs gradients. `on_progress` is called
+/// after every denoising step or iteration.
+pub fn solve(
+    prior: &Prior,
+    req: &SolveRequest,
+    error: &dyn MotionError,
+    device: &Device,
+    mut on_progress: impl FnMut(Progress),
+) -> Result<SolveResult, SolveError> {
+    let start = Instant::now();
+    let placements = validate(prior, req)?;
+    let people = req.prompts.len();
+    let ctx = Ctx {
+        prior: *prior,
+        error,
+        device: device.clone(),
+        samples: req.samples,
+        people,
+        frames: req.frames,
+        seed: req.seed,
+        guidance_scale: req.guidance_scale,
+        prompts: (0..req.samples)
+            .flat_map(|_| req.prompts.iter().cloned())
+            .collect(),
+        decoder: Decoder::new(prior.mean, prior.std, &placements),
+    };
+    let progress: &mut dyn FnMut(Progress) = &mut on_progress;
+    let out = match &req.solver {
+        Solver::Plain(kind) => Outcome {
+            x: host(ctx.sample_plain(*kind, progress)),
+            relax: None,
+            trace: Vec::new(),
+        },
+        Solver::Guide(c) => guide::run(&ctx, c, progress)?,
+        Solver::Latent(c) => latent::run(&ctx, c, progress)?,
+        Solver::Ik(c) => ik::run(&ctx, c, progress)?,
+        Solver::Lbfgs(c) => lbfgs::run(&ctx, c, progress)?,
+    };
+    ensure_finite(&out.x, req.solver.name(), "sample", || {
+        "the end of the solve".into()
+    })?;
+    finish(&ctx, out, &placements, start, req)
+}
+
+/// Features, world motions and errors of a solver's outcome.
+fn finish(
+    ctx: &Ctx,
+    out: Outcome,
+    placements: &[Placement],
+    start: Instant,
+    req: &SolveRequest,
+) -> Result<SolveResult, SolveError> {
+    let mut features = out.x;
+    for row in features.chunks_exact_mut(FEATURE_DIM) {
+        for ((v, s), m) in row.iter_mut().zip(ctx.prior.std).zip(ctx.prior.mean) {
+            *v = *v * s + m;
+        }
+    }
+    let per = ctx.frames * FEATURE_DIM;
+    let mut motions = Vec::with_capacity(ctx.samples);
+    let mut world = Vec::with_capacity(ctx.samples);
+    let mut flat = Vec::with_capacity(ctx.motions() * ctx.frames * NUM_JOINTS * 3);
+    for b in 0..ctx.samples {
+        let mut people = Vec::with_capacity(ctx.people);
+        let mut places = Vec::with_capacity(ctx.people);
+        for (p, outer) in placements.iter().enumerate() {
+            let m = b * ctx.people + p;
+            let place = match &out.relax {
+                Some(r) => outer.compose(&r[m]),
+                None => *outer,
+            };
+            let mut motion: Motion = recover_from_ric(&features[m * per..(m + 1) * per])?;
+            for pose in &mut motion.frames {
+                for j in pose.iter_mut() {
+                    *j = place.apply(*j);
+                }
+            }
+            flat.extend(motion.to_flat());
+            people.push(motion);
+            places.push(place);
+        }
+        motions.push(people);
+        world.push(places);
+    }
+    let joints = Tensor::<5>::from_data(
+        TensorData::new(flat, [ctx.samples, ctx.people, ctx.frames, NUM_JOINTS, 3]),
+        &ctx.device,
+    );
+    let e = ctx.error.error(joints);
+    check_shape(&e, ctx.samples)?;
+    let error = e.into_data().try_to_vec::<f32>().expect("f32 error");
+    ensure_finite(&error, req.solver.name(), "error", || {
+        "the returned motions".into()
+    })?;
+    let p: Vec<&str> = req.prompts.iter().map(String::as_str).collect();
+    let unknown_words = p
+        .iter()
+        .map(|text| ctx.prior.vocab.tokenize(text).1)
+        .collect();
+    Ok(SolveResult {
+        motions,
+        features,
+        placements: world,
+        error,
+        trace: out.trace,
+        seconds: start.elapsed().as_secs_f64(),
+        unknown_words,
+    })
+}
