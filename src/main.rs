@@ -28,6 +28,9 @@ enum Command {
     Bench(cli::bench::BenchCommand),
     /// Train the denoiser on a dataset built by `mprog data build`.
     Train(cli::train::TrainArgs),
+    /// Evaluate a model against real test clips (metrics, FID, R-precision), or train
+    /// the evaluator (`mprog eval train-encoder`).
+    Eval(cli::eval::EvalArgs),
 }
 
 fn main() -> miette::Result<()> {
@@ -39,6 +42,7 @@ fn main() -> miette::Result<()> {
         Command::Render(args) => cli::convert::render(args)?,
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
+        Command::Eval(args) => cli::eval::run(args)?,
     }
     Ok(())
 }
