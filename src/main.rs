@@ -16,6 +16,8 @@ struct Cli {
 enum Command {
     /// Print the joint names and aliases of the skeleton.
     Joints,
+    /// Generate motions from text with the shipped model.
+    Gen(cli::generate::GenArgs),
     /// Convert a motion file to other formats (by extension: bvh, npy, json, gif, png).
     Convert(cli::convert::ConvertArgs),
     /// Render a motion file as an animated GIF or a PNG strip.
@@ -28,6 +30,8 @@ enum Command {
     Bench(cli::bench::BenchCommand),
     /// Train the denoiser on a dataset built by `mprog data build`.
     Train(cli::train::TrainArgs),
+    /// Check `.mprog` programs and print their diagnostics.
+    Check(cli::check::CheckArgs),
     /// Evaluate a model against real test clips (metrics, FID, R-precision), or train
     /// the evaluator (`mprog eval train-encoder`).
     Eval(cli::eval::EvalArgs),
@@ -37,11 +41,17 @@ fn main() -> miette::Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Joints => print_joints(),
+        Command::Gen(args) => cli::generate::run(args)?,
         Command::Data(cmd) => cli::data::run(cmd)?,
         Command::Convert(args) => cli::convert::convert(args)?,
         Command::Render(args) => cli::convert::render(args)?,
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
+        Command::Check(args) => {
+            if !cli::check::run(&args)? {
+                std::process::exit(1);
+            }
+        }
         Command::Eval(args) => cli::eval::run(args)?,
     }
     Ok(())

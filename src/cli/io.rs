@@ -12,20 +12,35 @@ use std::path::{Path, PathBuf};
 pub fn load_people(path: &Path) -> Result<(Vec<Motion>, Meta)> {
     let loaded = read_motion(path).into_diagnostic()?;
     Ok(match loaded {
-        LoadedMotion::Joints { people, meta } => (people.into_iter().map(|p| p.motion).collect(), meta),
+        LoadedMotion::Joints { people, meta } => {
+            (people.into_iter().map(|p| p.motion).collect(), meta)
+        }
         LoadedMotion::Features(array) => {
             let motion = recover_from_ric(&array.data)
                 .into_diagnostic()
-                .wrap_err_with(|| format!("{}: recovering joints from HumanML3D features", path.display()))?;
+                .wrap_err_with(|| {
+                    format!(
+                        "{}: recovering joints from HumanML3D features",
+                        path.display()
+                    )
+                })?;
             (vec![motion], Meta::new())
         }
     })
 }
 
 /// Writes every requested output; pictures get `title`.
-pub fn write_outputs(outputs: &[PathBuf], people: &[Motion], meta: &Meta, title: &str) -> Result<()> {
+pub fn write_outputs(
+    outputs: &[PathBuf],
+    people: &[Motion],
+    meta: &Meta,
+    title: &str,
+) -> Result<()> {
     for out in outputs {
-        let ext = out.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+        let ext = out
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
         match ext.as_str() {
             "gif" | "png" => render_to_path(people, &RenderOptions::titled(title), out)
                 .into_diagnostic()
@@ -45,7 +60,6 @@ pub fn write_outputs(outputs: &[PathBuf], people: &[Motion], meta: &Meta, title:
 }
 
 /// Output paths with `_i` inserted before the extension, for sample `i` of `count`.
-#[allow(dead_code)] // used by `gen --count` (next commit)
 pub fn numbered(outputs: &[PathBuf], i: usize, count: usize) -> Vec<PathBuf> {
     if count == 1 {
         return outputs.to_vec();
@@ -53,8 +67,14 @@ pub fn numbered(outputs: &[PathBuf], i: usize, count: usize) -> Vec<PathBuf> {
     outputs
         .iter()
         .map(|p| {
-            let stem = p.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
-            let ext = p.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+            let stem = p
+                .file_stem()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_default();
+            let ext = p
+                .extension()
+                .map(|e| format!(".{}", e.to_string_lossy()))
+                .unwrap_or_default();
             p.with_file_name(format!("{stem}_{i}{ext}"))
         })
         .collect()

@@ -1,8 +1,10 @@
 //! Subcommands of the `mprog` binary, one file each.
 
 pub mod bench;
+pub mod check;
+pub mod convert;
 pub mod data;
 pub mod eval;
-pub mod train;
-pub mod convert;
+pub mod generate;
 pub mod io;
+pub mod train;

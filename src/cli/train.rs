@@ -5,6 +5,7 @@ use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::dataset::Dataset;
 use mprog::model::TrainConfig;
 use mprog::model::train::TrainRun;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// Arguments of `mprog train`.
@@ -86,6 +87,14 @@ pub fn run(args: TrainArgs) -> Result<()> {
         .run(&|state, loss, lr| {
             bar.set_position(state.step as u64);
             bar.set_message(format!("loss {loss:.4}  lr {lr:.1e}"));
+            // Without a terminal (a background run) the bar is hidden: log a line instead.
+            if !std::io::stderr().is_terminal() && state.step % 25 == 0 {
+                eprintln!(
+                    "step {} loss {loss:.4} lr {lr:.1e} {:.2} s/step",
+                    state.step,
+                    state.seconds / state.step.max(1) as f64
+                );
+            }
         })
         .into_diagnostic()?;
     bar.finish();

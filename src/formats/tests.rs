@@ -298,12 +298,31 @@ fn json_centimetres_and_other_rates_are_converted() {
 }
 
 #[test]
-fn dispatch_refuses_unknown_extensions_and_bvh_output() {
+fn dispatch_refuses_unknown_extensions_and_several_people_in_bvh() {
     let dir = tempfile::tempdir().unwrap();
     let m = [sample_motion(2, 0.0)];
-    let e = write_motion(&dir.path().join("x.bvh"), &m, &Meta::new()).unwrap_err();
+    let pose = crate::skeleton::rest_pose();
+    let standing = Motion::new(vec![pose; 3]);
+    write_motion(
+        &dir.path().join("one.bvh"),
+        std::slice::from_ref(&standing),
+        &Meta::new(),
+    )
+    .unwrap();
     assert!(
-        e.to_string().contains("BVH export is not implemented yet"),
+        std::fs::read_to_string(dir.path().join("one.bvh"))
+            .unwrap()
+            .starts_with("HIERARCHY")
+    );
+    let e = write_motion(
+        &dir.path().join("x.bvh"),
+        &[standing.clone(), standing],
+        &Meta::new(),
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("one skeleton but there are 2 people"),
         "{e}"
     );
     let e = write_motion(&dir.path().join("x.csv"), &m, &Meta::new()).unwrap_err();

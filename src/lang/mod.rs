@@ -1,1 +1,184 @@
-//! The `.mprog` language: syntax, checking, lowering to a differentiable error.
+//! The `.mprog` language: source → AST → checked IR → burn error graph.
+//!
+//! | stage | module | function | output |
+//! | --- | --- | --- | --- |
+//! | parse | [`syntax`] | [`syntax::source_to_ast`] | [`syntax::ast::Module`] |
+//! | check + lower | [`check`] | [`check::module_to_ir`] | [`ir::Ir`] + [`check::Header`] |
+//! | evaluate | [`eval`] | [`eval::evaluate`] | [`Evaluation`] (burn tensors) |
+//!
+//! [`compile`] runs the first two stages and returns a [`Program`]; [`check_source`]
+//! returns every diagnostic (errors and warnings) for `mprog check`. The language itself
+//! is described in `docs/language.md` (syntax, semantics, the scale of the total error).
+
+pub mod check;
+pub mod diag;
+pub mod eval;
+pub mod ir;
+pub mod stdlib;
+pub mod syntax;
+
+pub use check::{Header, ParamInfo, PersonInfo};
+pub use diag::{Diagnostic, Diagnostics, Severity};
+pub use eval::{EvalError, Evaluation};
+pub use ir::CostEstimate;
+
+use burn::tensor::Tensor;
+use std::sync::Arc;
+use syntax::ast::Span;
+
+/// A checked program, ready to evaluate.
+#[derive(Debug, Clone)]
+pub struct Program {
+    name: String,
+    checked: check::Checked,
+    warnings: Diagnostics,
+    cache: eval::IndexCache,
+}
+
+/// What one statement of a program is, for breakdowns.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct StatementInfo {
+    /// `line N: <source>`.
+    pub label: String,
+    /// 1-based source line.
+    pub line: usize,
+    /// Unit of its error.
+    pub unit: String,
+    /// Its weight.
+    pub weight: f64,
+    /// Loop iterations it stands for.
+    pub lanes: usize,
+    /// Its source span.
+    pub span: Span,
+}
+
+/// Parses and checks `source`; returns every diagnostic, warnings included.
+pub fn check_source(source: &str, name: &str, overrides: &[(String, f64)]) -> Diagnostics {
+    match compile_inner(source, name, overrides) {
+        Ok(p) => p.warnings,
+        Err(d) => d,
+    }
+}
+
+/// Parses, checks and lowers a program. `overrides` replace `param` defaults (values in the
+/// unit the default was written in). Errors come back as [`Diagnostics`].
+pub fn compile(
+    source: &str,
+    name: &str,
+    overrides: &[(String, f64)],
+) -> Result<Program, Diagnostics> {
+    compile_inner(source, name, overrides)
+}
+
+fn compile_inner(
+    source: &str,
+    name: &str,
+    overrides: &[(String, f64)],
+) -> Result<Program, Diagnostics> {
+    let text = Arc::new(source.to_string());
+    let (module, mut diags) = syntax::source_to_ast(source);
+    if diags.iter().any(|d| d.severity == Severity::Error) {
+        return Err(Diagnostics::new(name, text, diags));
+    }
+    let (checked, more) = check::module_to_ir(&module, source, stdlib::library(), overrides);
+    diags.extend(more);
+    let diagnostics = Diagnostics::new(name, text, diags);
+    match checked {
+        Some(checked) if !diagnostics.has_errors() => Ok(Program {
+            name: name.to_string(),
+            checked,
+            warnings: diagnostics,
+            cache: eval::IndexCache::default(),
+        }),
+        _ => Err(diagnostics),
+    }
+}
+
+impl Program {
+    /// Errors of a batch of motions `[batch, people, frames, 22, 3]` (metres, Y up).
+    ///
+    /// # Panics
+    /// If the tensor's shape does not fit the program; [`Program::try_evaluate`] reports it.
+    pub fn evaluate(&self, joints: Tensor<5>) -> Evaluation {
+        match self.try_evaluate(joints) {
+            Ok(e) => e,
+            Err(e) => panic!("{}: {e}", self.name),
+        }
+    }
+
+    /// Errors of a batch of motions, or why the tensor does not fit.
+    pub fn try_evaluate(&self, joints: Tensor<5>) -> Result<Evaluation, EvalError> {
+        eval::evaluate(&self.checked.ir, joints, &self.cache)
+    }
+
+    /// The statements, in the column order of [`Evaluation::per_statement`].
+    pub fn statements(&self) -> Vec<StatementInfo> {
+        self.checked
+            .ir
+            .statements
+            .iter()
+            .map(|s| StatementInfo {
+                label: s.label.clone(),
+                line: s.line,
+                unit: s.unit.clone(),
+                weight: s.weight,
+                lanes: s.lanes,
+                span: s.span,
+            })
+            .collect()
+    }
+
+    /// The program's name (file name).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The `prompt` line.
+    pub fn prompt(&self) -> Option<&str> {
+        self.checked.header.prompt.as_deref()
+    }
+
+    /// One prompt per person (the person's own, else the program's).
+    pub fn prompts(&self) -> Vec<Option<String>> {
+        let h = &self.checked.header;
+        h.people
+            .iter()
+            .map(|p| p.prompt.clone().or_else(|| h.prompt.clone()))
+            .collect()
+    }
+
+    /// Length in frames (20 fps).
+    pub fn length(&self) -> usize {
+        self.checked.header.length
+    }
+
+    /// The people, in tensor order (`me` for single-person programs).
+    pub fn people(&self) -> &[PersonInfo] {
+        &self.checked.header.people
+    }
+
+    /// Parameters after overrides.
+    pub fn params(&self) -> &[ParamInfo] {
+        &self.checked.header.params
+    }
+
+    /// Prompt, length, people and params.
+    pub fn header(&self) -> &Header {
+        &self.checked.header
+    }
+
+    /// Estimated evaluation cost at the declared length.
+    pub fn cost_estimate(&self) -> CostEstimate {
+        self.checked.cost
+    }
+
+    /// The lowered op list.
+    pub fn ir(&self) -> &ir::Ir {
+        &self.checked.ir
+    }
+
+    /// Warnings found while checking.
+    pub fn warnings(&self) -> &Diagnostics {
+        &self.warnings
+    }
+}

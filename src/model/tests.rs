@@ -101,7 +101,7 @@ fn ddim_is_deterministic_from_the_seed() {
             |_, _| {},
         )
         .into_data()
-        .to_vec::<f32>()
+        .try_to_vec::<f32>()
         .unwrap()
     };
     assert_eq!(run(1), run(1));

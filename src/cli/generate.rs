@@ -1,0 +1,124 @@
+//! `mprog gen`: text-to-motion with the shipped model, no program.
+
+use super::io::{numbered, write_outputs};
+use burn::prelude::*;
+use indicatif::{ProgressBar, ProgressStyle};
+use miette::{IntoDiagnostic, Result, WrapErr};
+use mprog::formats::Meta;
+use mprog::model::ModelBundle;
+use mprog::model::generate::{GenerateRequest, generate};
+use mprog::model::sampler::SamplerKind;
+use mprog::model::weights::default_model_dir;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `mprog gen`.
+#[derive(clap::Args)]
+pub struct GenArgs {
+    /// What the person does.
+    #[arg(long)]
+    text: String,
+    /// Length in seconds (20 fps).
+    #[arg(long, default_value_t = 6.0, conflicts_with = "frames")]
+    seconds: f32,
+    /// Length in frames (instead of --seconds).
+    #[arg(long)]
+    frames: Option<usize>,
+    /// Seed of the noise: the same seed, text and weights give the same motion.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Number of motions, generated as one batch (outputs get `_0`, `_1`, … suffixes).
+    #[arg(long, default_value_t = 1)]
+    count: usize,
+    /// Sampler: `ddim` (deterministic) or `ddpm`.
+    #[arg(long, default_value = "ddim")]
+    sampler: String,
+    /// Denoising steps (DDIM default 50; DDPM 1000 is the full chain).
+    #[arg(long)]
+    steps: Option<usize>,
+    /// Classifier-free guidance scale.
+    #[arg(long, default_value_t = 2.5)]
+    guidance: f32,
+    /// Model bundle folder (default: models/default).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Outputs by extension: .bvh .npy .json .gif .png (several allowed).
+    #[arg(short, long, num_args = 1.., required = true)]
+    out: Vec<PathBuf>,
+}
+
+/// Parses `--sampler`/`--steps`.
+pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
+    match name {
+        "ddim" => Ok(SamplerKind::Ddim(steps.unwrap_or(50))),
+        "ddpm" => Ok(SamplerKind::Ddpm(steps.unwrap_or(1000))),
+        other => Err(miette::miette!(
+            help = "use ddim or ddpm",
+            "unknown sampler `{other}`"
+        )),
+    }
+}
+
+/// Runs `mprog gen`.
+pub fn run(args: GenArgs) -> Result<()> {
+    let started = Instant::now();
+    let device = Device::flex();
+    let dir = args.model.clone().unwrap_or_else(default_model_dir);
+    let bundle = ModelBundle::load(&dir, &device)
+        .into_diagnostic()
+        .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
+    let frames = args
+        .frames
+        .unwrap_or((args.seconds * 20.0).round() as usize);
+    let sampler = sampler_kind(&args.sampler, args.steps)?;
+    let req = GenerateRequest {
+        prompts: vec![args.text.clone(); args.count.max(1)],
+        frames,
+        seed: args.seed,
+        sampler,
+        guidance_scale: args.guidance,
+    };
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} denoising steps [{elapsed}]")
+            .expect("template"),
+    );
+    let out = generate(&bundle, &req, &device, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })
+    .into_diagnostic()?;
+    bar.finish_and_clear();
+    if let Some(unknown) = out.unknown_words.first().filter(|u| !u.is_empty()) {
+        eprintln!(
+            "ignored words the model does not know: {}",
+            unknown.join(", ")
+        );
+    }
+    let mut meta = Meta::new();
+    meta.insert("text".into(), args.text.clone().into());
+    meta.insert("seed".into(), args.seed.into());
+    meta.insert("sampler".into(), format!("{sampler:?}").into());
+    meta.insert("guidance_scale".into(), (args.guidance as f64).into());
+    meta.insert(
+        "weights_id".into(),
+        bundle.manifest.weights_id.clone().into(),
+    );
+    let count = out.motions.len();
+    for (i, motion) in out.motions.iter().enumerate() {
+        let mut m = meta.clone();
+        m.insert("sample".into(), i.into());
+        write_outputs(
+            &numbered(&args.out, i, count),
+            std::slice::from_ref(motion),
+            &m,
+            &args.text,
+        )?;
+    }
+    eprintln!(
+        "generated {count} motion(s) of {frames} frames in {:.1} s (weights {})",
+        started.elapsed().as_secs_f64(),
+        bundle.manifest.weights_id
+    );
+    Ok(())
+}

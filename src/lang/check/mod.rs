@@ -1,0 +1,301 @@
+//! Checking: AST → checked IR. Resolves names (joints, aliases, people, parameters,
+//! functions, loop variables), checks types and units, inlines functions, unrolls loops
+//! into lanes, turns time blocks into frame domains and `if`s into masks, and reports every
+//! problem as a diagnostic. The output is the backend-free [`Ir`] plus the header.
+//!
+//! | file | what it checks |
+//! | --- | --- |
+//! | `header.rs` | prompt, length, params (+ overrides), people, definitions, recursion |
+//! | `stmt.rs` | statements, time blocks, loops, `if`, weights |
+//! | `expr.rs` | expressions, names, members, lists, `@` |
+//! | `ops.rs` | operators: kinds and units |
+//! | `calls.rs` | builtin and user function calls |
+//! | `time.rs` | time positions (`2s`, `50%`, `end - 1`) |
+//! | `builder.rs` | IR nodes: shapes, sharing, constant folding |
+
+mod builder;
+pub mod builtins;
+mod calls;
+mod expr;
+mod header;
+mod ops;
+mod stmt;
+mod time;
+pub mod units;
+pub mod values;
+
+use crate::lang::diag::{Diagnostic, Severity};
+use crate::lang::ir::{CostEstimate, Ir, NodeId};
+use crate::lang::syntax::ast::{Expr, FnDef, Module, Span};
+use builder::Builder;
+use std::collections::HashMap;
+use units::Unit;
+use values::Cx;
+
+/// Most tensor ops a program may need per evaluation.
+pub const MAX_OPS: usize = 20_000;
+/// Most tensor elements a program may produce per sample and evaluation.
+pub const MAX_ELEMENTS_PER_SAMPLE: usize = 20_000_000;
+/// Most expression elaborations one check may take.
+pub const MAX_WORK: usize = 1_000_000;
+/// Longest motion accepted, in frames.
+pub const MAX_LENGTH: usize = 4000;
+/// Frames the motion model generates at most.
+pub const MODEL_MAX_FRAMES: usize = 196;
+
+/// A person of the program.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct PersonInfo {
+    /// Name (`me` in single-person programs).
+    pub name: String,
+    /// Their prompt.
+    pub prompt: Option<String>,
+}
+
+/// A parameter after overrides.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ParamInfo {
+    /// Name.
+    pub name: String,
+    /// Value in SI units (1 or 3 numbers).
+    pub value: Vec<f64>,
+    /// Unit, as text.
+    pub unit: String,
+    /// Factor from the unit the default was written in to SI (`--set` values use it).
+    #[serde(skip)]
+    pub scale: f64,
+    #[serde(skip)]
+    pub(crate) node: NodeId,
+    #[serde(skip)]
+    pub(crate) unit_value: Unit,
+    #[serde(skip)]
+    pub(crate) span: Span,
+}
+
+/// The header of a checked program.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Header {
+    /// The `prompt` line.
+    pub prompt: Option<String>,
+    /// Length in frames.
+    pub length: usize,
+    /// People in tensor order.
+    pub people: Vec<PersonInfo>,
+    /// Parameters.
+    pub params: Vec<ParamInfo>,
+}
+
+/// A checked program.
+#[derive(Clone, Debug)]
+pub struct Checked {
+    /// Prompt, length, people, params.
+    pub header: Header,
+    /// The op list.
+    pub ir: Ir,
+    /// Its estimated cost.
+    pub cost: CostEstimate,
+}
+
+/// The checker's state while walking one program.
+pub(crate) struct Checker<'a> {
+    pub b: Builder,
+    pub diags: Vec<Diagnostic>,
+    pub source: &'a str,
+    pub header: Header,
+    pub multi: bool,
+    pub user_fns: HashMap<&'a str, &'a FnDef>,
+    pub lib_fns: HashMap<&'a str, &'a FnDef>,
+    pub lib_lets: HashMap<&'a str, &'a Expr>,
+    /// Recursive functions (reported once; calls to them elaborate to errors).
+    pub poisoned: std::collections::HashSet<&'a str>,
+    /// Expressions elaborated so far (see [`MAX_WORK`]).
+    pub work: usize,
+    pub statements: Vec<crate::lang::ir::Statement>,
+}
+
+impl<'a> Checker<'a> {
+    /// Records a diagnostic; inside a library function it moves to the user's call site.
+    pub fn report(&mut self, cx: &Cx, mut d: Diagnostic) {
+        if let Some(site) = cx.site {
+            d.span = site;
+            d.message = format!("{} (inside this library call)", d.message);
+        }
+        self.diags.push(d);
+    }
+
+    /// Shorthand for an error.
+    pub fn error(
+        &mut self,
+        cx: &Cx,
+        code: &'static str,
+        span: Span,
+        msg: impl Into<String>,
+    ) -> ErrorBuilder<'_, 'a> {
+        ErrorBuilder {
+            checker: self,
+            cx: cx.clone(),
+            d: Some(Diagnostic::error(code, span, msg)),
+        }
+    }
+
+    /// The 1-based line of a byte offset in the user's source.
+    pub fn line_of(&self, offset: usize) -> usize {
+        crate::lang::diag::line_col(self.source, offset).0
+    }
+}
+
+/// A diagnostic being built; it is recorded when dropped.
+pub(crate) struct ErrorBuilder<'c, 'a> {
+    checker: &'c mut Checker<'a>,
+    cx: Cx,
+    d: Option<Diagnostic>,
+}
+
+impl ErrorBuilder<'_, '_> {
+    /// Label under the span.
+    pub fn label(mut self, l: impl Into<String>) -> Self {
+        self.d = self.d.take().map(|d| d.label(l));
+        self
+    }
+
+    /// Fix-it hint.
+    pub fn help(mut self, h: impl Into<String>) -> Self {
+        self.d = self.d.take().map(|d| d.help(h));
+        self
+    }
+
+    /// Turns it into a warning.
+    pub fn warning(mut self) -> Self {
+        self.d = self.d.take().map(|mut d| {
+            d.severity = Severity::Warning;
+            d
+        });
+        self
+    }
+}
+
+impl Drop for ErrorBuilder<'_, '_> {
+    fn drop(&mut self) {
+        if let Some(d) = self.d.take() {
+            let cx = self.cx.clone();
+            self.checker.report(&cx, d);
+        }
+    }
+}
+
+/// Checks a parsed program against the library and lowers it to IR.
+/// `overrides` replace parameter defaults (values in the unit the default was written in).
+pub fn module_to_ir<'a>(
+    module: &'a Module,
+    source: &'a str,
+    library: &'a [Module],
+    overrides: &[(String, f64)],
+) -> (Option<Checked>, Vec<Diagnostic>) {
+    let mut c = Checker {
+        b: Builder::new(),
+        diags: Vec::new(),
+        source,
+        header: Header::default(),
+        multi: false,
+        user_fns: HashMap::new(),
+        lib_fns: HashMap::new(),
+        lib_lets: HashMap::new(),
+        poisoned: Default::default(),
+        work: 0,
+        statements: Vec::new(),
+    };
+    c.load_library(library);
+    c.header_items(module, overrides);
+    c.body(module);
+    if c.b.overflow {
+        c.diags.push(
+            Diagnostic::error(
+                "mprog::too_costly",
+                Span::default(),
+                format!(
+                    "the program expands to more than {} tensor ops",
+                    builder::MAX_NODES
+                ),
+            )
+            .help("loops and functions are unrolled when checking; use fewer or smaller loops"),
+        );
+    }
+    let has_errors = c.diags.iter().any(|d| d.severity == Severity::Error);
+    if c.statements.is_empty() && !has_errors {
+        c.diags.push(
+            Diagnostic::error(
+                "mprog::empty_program",
+                Span::new(0, 0),
+                "the program has no constraints",
+            )
+            .label("nothing to satisfy here")
+            .help(
+                "add a constraint, e.g. `always { head.y > 1.5 m }` or `at end { pelvis.z > 2 m }`",
+            ),
+        );
+    }
+    if c.diags.iter().any(|d| d.severity == Severity::Error) {
+        return (None, c.diags);
+    }
+    let ir = c.finish();
+    let cost = ir.cost_estimate();
+    if cost.ops > MAX_OPS || cost.elements_per_sample > MAX_ELEMENTS_PER_SAMPLE {
+        c.diags.push(
+            Diagnostic::error(
+                "mprog::too_costly",
+                Span::new(0, 0),
+                format!(
+                    "evaluating this program is estimated at {} tensor ops and {} elements per \
+                     sample; the limits are {MAX_OPS} ops and {MAX_ELEMENTS_PER_SAMPLE} elements",
+                    cost.ops, cost.elements_per_sample
+                ),
+            )
+            .help("use fewer nested loops over `joints`, shorter `during` ranges, or a shorter length"),
+        );
+        return (None, c.diags);
+    }
+    let header = c.header.clone();
+    (Some(Checked { header, ir, cost }), c.diags)
+}
+
+impl Checker<'_> {
+    /// Drops nodes no statement reads and packs the rest into an [`Ir`].
+    fn finish(&mut self) -> Ir {
+        let nodes = std::mem::take(&mut self.b.nodes);
+        let mut live = vec![false; nodes.len()];
+        for s in &self.statements {
+            live[s.error] = true;
+            if let Some(m) = s.mask {
+                live[m] = true;
+            }
+        }
+        for i in (0..nodes.len()).rev() {
+            if live[i] {
+                for a in nodes[i].op.args() {
+                    live[a] = true;
+                }
+            }
+        }
+        let mut remap = vec![usize::MAX; nodes.len()];
+        let mut kept = Vec::new();
+        for (i, mut n) in nodes.into_iter().enumerate() {
+            if live[i] {
+                n.op.map_args(|a| remap[a]);
+                remap[i] = kept.len();
+                kept.push(n);
+            }
+        }
+        let mut statements = std::mem::take(&mut self.statements);
+        for s in &mut statements {
+            s.error = remap[s.error];
+            s.mask = s.mask.map(|m| remap[m]);
+        }
+        Ir {
+            nodes: kept,
+            domains: std::mem::take(&mut self.b.domains),
+            statements,
+            people: self.header.people.len(),
+            length: self.header.length,
+        }
+    }
+}

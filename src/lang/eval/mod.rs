@@ -1,0 +1,288 @@
+//! Evaluation: checked [`Ir`] + joint positions → error per sample and per statement,
+//! with burn tensor ops on any device, with or without autodiff. Everything is vectorised
+//! over batch, frames and lanes: time blocks are index selections, `if`s are masks.
+//!
+//! # Shapes
+//! * input `[batch, people, frames, 22, 3]`;
+//! * every node `[batch or 1, frames of its domain or 1, lanes or 1, channels]`;
+//! * output `total [batch]`, `per_statement [batch, statements]`.
+
+mod ops;
+
+use crate::lang::ir::*;
+use crate::skeleton::NUM_JOINTS;
+use burn::tensor::{Int, Tensor, TensorData};
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+/// Errors of one evaluation.
+pub struct Evaluation {
+    /// Σ over statements of weight × mean error, per sample `[batch]`.
+    pub total: Tensor<1>,
+    /// Each statement's weighted mean error `[batch, statements]`.
+    pub per_statement: Tensor<2>,
+}
+
+/// Why a tensor cannot be evaluated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EvalError {
+    /// The input does not have the expected shape.
+    #[error("joint tensor has shape {got:?}; expected [batch, {people}, frames ≥ 1, 22, 3]")]
+    BadShape {
+        /// Shape given.
+        got: Vec<usize>,
+        /// People the program declares.
+        people: usize,
+    },
+}
+
+/// Frame-index tensors for one frame count and device, reused across evaluations.
+#[derive(Default)]
+pub struct IndexCache {
+    inner: Mutex<Option<CachedIndices>>,
+}
+
+struct CachedIndices {
+    frames: usize,
+    device: burn::tensor::Device,
+    gathers: HashMap<NodeId, Tensor<1, Int>>,
+    consts: HashMap<NodeId, Tensor<4>>,
+    domain_sizes: Vec<usize>,
+}
+
+impl Clone for IndexCache {
+    fn clone(&self) -> Self {
+        IndexCache::default()
+    }
+}
+
+impl std::fmt::Debug for IndexCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("IndexCache")
+    }
+}
+
+/// Flat row index of (person, frame, joint) in the `[batch, people·frames·22, 3]` view.
+fn flat(person: usize, frame: usize, joint: usize, frames: usize) -> i64 {
+    ((person * frames + frame) * NUM_JOINTS + joint) as i64
+}
+
+fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> CachedIndices {
+    let domain_sizes: Vec<usize> = (0..ir.domains.len())
+        .map(|d| ir.resolve_domain(d, frames).len())
+        .collect();
+    let mut gathers = HashMap::new();
+    let mut consts = HashMap::new();
+    for (i, node) in ir.nodes.iter().enumerate() {
+        if let Op::Const(v) = &node.op {
+            let c = v.len();
+            let t = Tensor::<1>::from_data(TensorData::new(v.clone(), [c]), device)
+                .reshape([1, 1, 1, c]);
+            consts.insert(i, t);
+        }
+        let (domain, points): (DomainId, Vec<(usize, usize)>) = match &node.op {
+            Op::Gather { domain, points } => (*domain, points.clone()),
+            Op::MassCenter {
+                domain, persons, ..
+            } => (
+                *domain,
+                persons
+                    .iter()
+                    .flat_map(|&p| (0..NUM_JOINTS).map(move |j| (p, j)))
+                    .collect(),
+            ),
+            _ => continue,
+        };
+        let mut ts = ir.resolve_domain(domain, frames);
+        if ts.is_empty() {
+            // An empty domain still needs a well-formed tensor; its statement reads 0.
+            ts.push(0);
+        }
+        let idx: Vec<i64> = ts
+            .iter()
+            .flat_map(|&t| points.iter().map(move |&(p, j)| flat(p, t, j, frames)))
+            .collect();
+        let n = idx.len();
+        gathers.insert(
+            i,
+            Tensor::<1, Int>::from_data(TensorData::new(idx, [n]), device),
+        );
+    }
+    CachedIndices {
+        frames,
+        device: device.clone(),
+        gathers,
+        consts,
+        domain_sizes,
+    }
+}
+
+/// Evaluates `ir` on joint positions `[batch, people, frames, 22, 3]`.
+pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evaluation, EvalError> {
+    let [batch, people, frames, nj, nc] = joints.dims();
+    if people != ir.people || nj != NUM_JOINTS || nc != 3 || frames == 0 || batch == 0 {
+        return Err(EvalError::BadShape {
+            got: vec![batch, people, frames, nj, nc],
+            people: ir.people,
+        });
+    }
+    let device = joints.device();
+    let mut guard = cache.inner.lock().unwrap_or_else(|e| e.into_inner());
+    let stale = guard
+        .as_ref()
+        .is_none_or(|c| c.frames != frames || c.device != device);
+    if stale {
+        *guard = Some(build_indices(ir, frames, &device));
+    }
+    let Some(idx) = guard.as_ref() else {
+        unreachable!("cache filled above")
+    };
+    // [batch, people·frames·22, 3]
+    let rows = joints.reshape([batch, people * frames * NUM_JOINTS, 3]);
+    let mut values: Vec<Option<Tensor<4>>> = vec![None; ir.nodes.len()];
+    let last_use = last_uses(ir);
+    for (i, node) in ir.nodes.iter().enumerate() {
+        let get = |values: &Vec<Option<Tensor<4>>>, a: NodeId| {
+            values[a].clone().expect("nodes are in SSA order")
+        };
+        let frames_of = |n: &Node| match n.frames {
+            Frames::Const => 1,
+            Frames::Domain(d) => idx.domain_sizes[d].max(1),
+        };
+        let t = match &node.op {
+            Op::Const(_) => idx.consts[&i].clone(),
+            Op::Gather { .. } => {
+                // [batch, |D|·K, 3] → [batch, |D|, K, 3]
+                let g = rows.clone().select(1, idx.gathers[&i].clone());
+                g.reshape([batch, frames_of(node), node.lanes, 3])
+            }
+            Op::MassCenter { weights, .. } => {
+                let g = rows.clone().select(1, idx.gathers[&i].clone());
+                // [batch, |D|, K, 22, 3] weighted over joints → [batch, |D|, K, 3]
+                let g: Tensor<5> = g.reshape([batch, frames_of(node), node.lanes, NUM_JOINTS, 3]);
+                let w =
+                    Tensor::<1>::from_data(TensorData::new(weights.clone(), [NUM_JOINTS]), &device)
+                        .reshape([1, 1, 1, NUM_JOINTS, 1]);
+                (g * w)
+                    .sum_dim(3)
+                    .reshape([batch, frames_of(node), node.lanes, 3])
+            }
+            Op::Component { arg, axis } => get(&values, *arg).narrow(3, *axis, 1),
+            Op::Compose(parts) => {
+                let ts: Vec<Tensor<4>> = parts.iter().map(|&p| get(&values, p)).collect();
+                let shape = ops::common_shape(&ts.iter().collect::<Vec<_>>(), 1);
+                Tensor::cat(ts.into_iter().map(|t| t.expand(shape)).collect(), 3)
+            }
+            Op::Unary { op, arg } => ops::unary(*op, get(&values, *arg)),
+            Op::Binary { op, a, b } => ops::binary(*op, get(&values, *a), get(&values, *b)),
+            Op::SumChannels(a) => get(&values, *a).sum_dim(3),
+            Op::Norm(a) => get(&values, *a)
+                .square()
+                .sum_dim(3)
+                .add_scalar(1e-12)
+                .sqrt(),
+            Op::Cross(a, b) => {
+                let (x, y) = (get(&values, *a), get(&values, *b));
+                let shape = ops::common_shape(&[&x, &y], 3);
+                x.expand(shape).cross(y.expand(shape), 3)
+            }
+            Op::Relabel(a) => get(&values, *a),
+            Op::SupportDist { point, feet } => {
+                ops::support_dist(get(&values, *point), get(&values, *feet), node.lanes)
+            }
+            Op::Less { a, b } => {
+                let (x, y) = (get(&values, *a), get(&values, *b));
+                let c = x.dims()[3].max(y.dims()[3]);
+                let shape = ops::common_shape(&[&x, &y], c);
+                x.expand(shape).lower(y.expand(shape)).float().min_dim(3)
+            }
+        };
+        values[i] = Some(t);
+        // Free inputs whose last reader this was (keeps memory flat for long programs).
+        for a in node.op.args() {
+            if last_use[a] == i {
+                values[a] = None;
+            }
+        }
+    }
+    let mut columns = Vec::with_capacity(ir.statements.len());
+    for s in &ir.statements {
+        columns.push(statement_error(ir, s, &values, idx, batch, &device));
+    }
+    drop(guard);
+    let per_statement = if columns.len() == 1 {
+        columns.remove(0)
+    } else {
+        Tensor::cat(columns, 1)
+    };
+    let total = per_statement.clone().sum_dim(1).reshape([batch]);
+    Ok(Evaluation {
+        total,
+        per_statement,
+    })
+}
+
+/// For each node, the last node that reads it (statements count as reading at the end).
+fn last_uses(ir: &Ir) -> Vec<usize> {
+    let mut last = vec![0usize; ir.nodes.len()];
+    for (i, n) in ir.nodes.iter().enumerate() {
+        for a in n.op.args() {
+            last[a] = i;
+        }
+    }
+    for s in &ir.statements {
+        last[s.error] = usize::MAX;
+        if let Some(m) = s.mask {
+            last[m] = usize::MAX;
+        }
+    }
+    last
+}
+
+/// weight × mean over the statement's frames (masked), summed over lanes → `[batch, 1]`.
+fn statement_error(
+    ir: &Ir,
+    s: &Statement,
+    values: &[Option<Tensor<4>>],
+    idx: &CachedIndices,
+    batch: usize,
+    device: &burn::tensor::Device,
+) -> Tensor<2> {
+    if idx.domain_sizes[s.domain] == 0 {
+        return Tensor::<2>::zeros([batch, 1], device);
+    }
+    let err = values[s.error].clone().expect("statement error is kept");
+    let (reduced, lanes) = match s.mask.and_then(|m| values[m].clone()) {
+        Some(mask) => {
+            let lanes = err.dims()[2].max(mask.dims()[2]);
+            // Σ_t e·m / max(Σ_t m, 1): mean over the frames where the condition holds.
+            let num = (err * mask.clone()).sum_dim(1);
+            let den = mask.sum_dim(1).clamp_min(1.0);
+            (num / den, lanes)
+        }
+        None => {
+            let lanes = err.dims()[2];
+            (err.mean_dim(1), lanes)
+        }
+    };
+    let factor = s.weight * (s.lanes / lanes.max(1)) as f64;
+    let b = reduced.dims()[0];
+    // Skip no-op tensor ops: each costs a few µs of dispatch and tape at small sizes.
+    let reduced = if lanes > 1 {
+        reduced.sum_dim(2)
+    } else {
+        reduced
+    };
+    let col = reduced.reshape([b, 1]);
+    let col = if factor == 1.0 {
+        col
+    } else {
+        col.mul_scalar(factor)
+    };
+    let _ = ir;
+    if b == batch {
+        col
+    } else {
+        col.expand([batch, 1])
+    }
+}

@@ -1,0 +1,329 @@
+//! The checked, backend-free IR: a serialisable list of tensor ops in SSA order, the
+//! frame domains they are evaluated over, and the statements whose errors make up the
+//! total. Produced by [`crate::lang::check`], consumed by [`crate::lang::eval`].
+//!
+//! Every value is a 4-d tensor `[batch, frames, lanes, channels]`:
+//! * `frames` is the size of the node's frame domain, or 1 (broadcast) for values that are
+//!   the same at every frame (constants, `x@t`);
+//! * `lanes` is 1, or the number of unrolled loop iterations (`for j in …` runs all
+//!   iterations side by side as lanes instead of repeating the ops);
+//! * `channels` is 1 for scalars and masks, 3 for vectors.
+
+use super::syntax::ast::Span;
+use serde::{Deserialize, Serialize};
+
+/// Index of a node in [`Ir::nodes`].
+pub type NodeId = usize;
+/// Index of a domain in [`Ir::domains`].
+pub type DomainId = usize;
+
+/// A frame position `round(frames + fraction · (F − 1))`, clamped to the motion, where F
+/// is the number of frames evaluated: `2s` is `{40, 0}`, `end` is `{0, 1}`, `50%` is
+/// `{0, 0.5}`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TimePoint {
+    /// Absolute part, in frames.
+    pub frames: f64,
+    /// Part relative to the last frame.
+    pub fraction: f64,
+}
+
+impl TimePoint {
+    /// The frame index in a motion of `f` frames (unclamped).
+    pub fn frame_unclamped(&self, f: usize) -> f64 {
+        (self.frames + self.fraction * (f.max(1) - 1) as f64).round()
+    }
+
+    /// The frame index in a motion of `f` frames, clamped to `[0, f - 1]`.
+    pub fn frame(&self, f: usize) -> usize {
+        self.frame_unclamped(f).clamp(0.0, (f.max(1) - 1) as f64) as usize
+    }
+}
+
+/// Which neighbour a finite difference reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Shift {
+    /// `min(t + 1, F − 1)`: the later frame of a first difference.
+    VelHi,
+    /// `min(t + 1, F − 1) − 1`: the earlier frame of a first difference.
+    VelLo,
+    /// `min(t, F − 3) + k`: frame k of a second difference.
+    Acc(u8),
+}
+
+/// A set of frames, resolved to a list of indices once the frame count is known.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Domain {
+    /// Every frame, in order.
+    All,
+    /// The listed keyframes (duplicates removed, in the order given).
+    At(Vec<TimePoint>),
+    /// Frames in `[from, to)`.
+    During(TimePoint, TimePoint),
+    /// Frames of the first domain that are also in the second.
+    Intersect(DomainId, DomainId),
+    /// Each frame of `base` mapped to a neighbour (velocities, accelerations).
+    Shift(DomainId, Shift),
+}
+
+/// Whether a node varies along the frame axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Frames {
+    /// Size 1: the same at every frame.
+    Const,
+    /// One entry per frame of the domain.
+    Domain(DomainId),
+}
+
+/// Elementwise one-argument ops.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum UnaryOp {
+    Neg,
+    Abs,
+    /// `sqrt(max(x, 0) + 1e-12)`: finite gradient at 0.
+    Sqrt,
+    /// `max(x, 0)`.
+    Relu,
+    Sin,
+    Cos,
+    Square,
+    /// `1 − x` (mask complement).
+    OneMinus,
+}
+
+/// Elementwise two-argument ops (with broadcasting).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum BinaryOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Min,
+    Max,
+    Atan2,
+}
+
+/// One tensor op.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Op {
+    /// A constant `[1, 1, 1, len]`.
+    Const(Vec<f32>),
+    /// Joint positions `[B, |D|, K, 3]`: lane k reads `(person, joint)` = `points[k]`.
+    Gather {
+        domain: DomainId,
+        points: Vec<(usize, usize)>,
+    },
+    /// Weighted sum over all 22 joints of each lane's person `[B, |D|, K, 3]`.
+    MassCenter {
+        domain: DomainId,
+        persons: Vec<usize>,
+        weights: Vec<f32>,
+    },
+    /// Channel `axis` of a vector.
+    Component { arg: NodeId, axis: usize },
+    /// Three scalars stacked into a vector.
+    Compose([NodeId; 3]),
+    /// Elementwise op.
+    Unary { op: UnaryOp, arg: NodeId },
+    /// Elementwise op.
+    Binary { op: BinaryOp, a: NodeId, b: NodeId },
+    /// Sum over channels.
+    SumChannels(NodeId),
+    /// `sqrt(Σ x² + 1e-12)` over channels.
+    Norm(NodeId),
+    /// Cross product of two vectors.
+    Cross(NodeId, NodeId),
+    /// The argument re-labelled onto another frame domain of the same size (finite
+    /// differences read shifted domains and are labelled with the statement's domain).
+    Relabel(NodeId),
+    /// Signed ground distance of `point` to the support polygon of the 4 foot joints in
+    /// `feet` (a gather with 4 lanes per lane): positive outside, negative inside.
+    SupportDist { point: NodeId, feet: NodeId },
+    /// Mask `a < b` as 0/1, all channels (no gradient).
+    Less { a: NodeId, b: NodeId },
+}
+
+impl Op {
+    /// The nodes this op reads.
+    pub fn args(&self) -> Vec<NodeId> {
+        match self {
+            Op::Const(_) | Op::Gather { .. } | Op::MassCenter { .. } => vec![],
+            Op::Component { arg, .. } | Op::Unary { arg, .. } => vec![*arg],
+            Op::SumChannels(a) | Op::Norm(a) | Op::Relabel(a) => vec![*a],
+            Op::Compose(a) => a.to_vec(),
+            Op::Binary { a, b, .. } | Op::Cross(a, b) | Op::Less { a, b } => vec![*a, *b],
+            Op::SupportDist { point, feet } => vec![*point, *feet],
+        }
+    }
+
+    /// Remaps the nodes this op reads.
+    pub fn map_args(&mut self, f: impl Fn(NodeId) -> NodeId) {
+        match self {
+            Op::Const(_) | Op::Gather { .. } | Op::MassCenter { .. } => {}
+            Op::Component { arg, .. } | Op::Unary { arg, .. } => *arg = f(*arg),
+            Op::SumChannels(a) | Op::Norm(a) | Op::Relabel(a) => *a = f(*a),
+            Op::Compose(a) => a.iter_mut().for_each(|x| *x = f(*x)),
+            Op::Binary { a, b, .. } | Op::Cross(a, b) | Op::Less { a, b } => {
+                *a = f(*a);
+                *b = f(*b);
+            }
+            Op::SupportDist { point, feet } => {
+                *point = f(*point);
+                *feet = f(*feet);
+            }
+        }
+    }
+}
+
+/// A node: an op, the source it came from, and its shape.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Node {
+    /// What to compute.
+    pub op: Op,
+    /// The source that asked for it (for runtime messages).
+    pub span: Span,
+    /// Frame axis.
+    pub frames: Frames,
+    /// Lane count (1 or the statement's lane count).
+    pub lanes: usize,
+    /// 1 or 3.
+    pub channels: usize,
+    /// True when the value depends on the motion.
+    pub motion: bool,
+}
+
+/// One statement: its error per (sample, frame, lane), where it applies, and its weight.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Statement {
+    /// Error `[B, |D| or 1, K or 1, 1]`.
+    pub error: NodeId,
+    /// Optional 0/1 mask of the frames it applies to (from `if`), same layout.
+    pub mask: Option<NodeId>,
+    /// Frames it applies to.
+    pub domain: DomainId,
+    /// Number of unrolled loop iterations it stands for.
+    pub lanes: usize,
+    /// Multiplier of its mean error.
+    pub weight: f64,
+    /// The constraint's source.
+    pub span: Span,
+    /// 1-based source line.
+    pub line: usize,
+    /// `line N: <source text>`.
+    pub label: String,
+    /// Unit of the error (`m`, `m/s`, `rad`, …).
+    pub unit: String,
+}
+
+/// A whole checked program, ready to evaluate.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Ir {
+    /// Ops in evaluation order.
+    pub nodes: Vec<Node>,
+    /// Frame domains.
+    pub domains: Vec<Domain>,
+    /// Statements, in source order.
+    pub statements: Vec<Statement>,
+    /// Number of people (tensor axis 1).
+    pub people: usize,
+    /// Declared length in frames.
+    pub length: usize,
+}
+
+/// What evaluating a program costs, estimated at the declared length.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CostEstimate {
+    /// Tensor ops of one evaluation (forward), statement reductions included.
+    pub ops: usize,
+    /// Tensor elements produced per sample in one forward pass.
+    pub elements_per_sample: usize,
+}
+
+impl CostEstimate {
+    /// Rough element work of forward + backward for a batch (backward ≈ 2× forward).
+    pub fn work(&self, batch: usize) -> f64 {
+        3.0 * self.elements_per_sample as f64 * batch as f64
+    }
+}
+
+impl Ir {
+    /// Frame indices of a domain for a motion of `f` frames.
+    pub fn resolve_domain(&self, d: DomainId, f: usize) -> Vec<usize> {
+        let last = f.max(1) - 1;
+        match &self.domains[d] {
+            Domain::All => (0..f).collect(),
+            Domain::At(points) => {
+                let mut out: Vec<usize> = Vec::with_capacity(points.len());
+                for p in points {
+                    let t = p.frame(f);
+                    if !out.contains(&t) {
+                        out.push(t);
+                    }
+                }
+                out
+            }
+            Domain::During(a, b) => {
+                let a = a.frame_unclamped(f).clamp(0.0, f as f64) as usize;
+                let b = b.frame_unclamped(f).clamp(0.0, f as f64) as usize;
+                (a..b.max(a)).collect()
+            }
+            Domain::Intersect(a, b) => {
+                let inner = self.resolve_domain(*b, f);
+                self.resolve_domain(*a, f)
+                    .into_iter()
+                    .filter(|t| inner.contains(t))
+                    .collect()
+            }
+            Domain::Shift(base, shift) => self
+                .resolve_domain(*base, f)
+                .into_iter()
+                .map(|t| match shift {
+                    Shift::VelHi => (t + 1).min(last),
+                    Shift::VelLo => (t + 1).min(last).saturating_sub(1),
+                    Shift::Acc(k) => (t.min(last.saturating_sub(2)) + *k as usize).min(last),
+                })
+                .collect(),
+        }
+    }
+
+    /// Number of frames a node spans for a motion of `f` frames.
+    pub fn frames_of(&self, n: NodeId, f: usize) -> usize {
+        match self.nodes[n].frames {
+            Frames::Const => 1,
+            Frames::Domain(d) => self.resolve_domain(d, f).len(),
+        }
+    }
+
+    /// Estimated cost of one evaluation at the declared length.
+    pub fn cost_estimate(&self) -> CostEstimate {
+        let f = self.length.max(1);
+        let mut domain_len = vec![None; self.domains.len()];
+        let mut len_of = |d: DomainId| -> usize {
+            *domain_len[d].get_or_insert_with(|| self.resolve_domain(d, f).len())
+        };
+        let mut elements = 0usize;
+        let mut ops = 0usize;
+        for node in &self.nodes {
+            let frames = match node.frames {
+                Frames::Const => 1,
+                Frames::Domain(d) => len_of(d),
+            };
+            let per_op = match &node.op {
+                Op::SupportDist { .. } => 30,
+                Op::MassCenter { .. } => 3,
+                Op::Less { .. } => 3,
+                _ => 1,
+            };
+            ops += per_op;
+            elements = elements.saturating_add(per_op * frames * node.lanes * node.channels);
+        }
+        for s in &self.statements {
+            ops += if s.mask.is_some() { 6 } else { 3 };
+            elements = elements.saturating_add(len_of(s.domain) * s.lanes * 2);
+        }
+        CostEstimate {
+            ops: ops + 2,
+            elements_per_sample: elements,
+        }
+    }
+}

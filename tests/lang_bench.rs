@@ -1,0 +1,78 @@
+//! Timing of every program: evaluation, and evaluation + gradient, at batch 1 and 32 with
+//! 196 frames on `Device::flex()`. Ignored by default; run with
+//! `cargo test --release --test lang_bench -- --ignored --nocapture`.
+
+mod lang_common;
+
+use burn::tensor::{Device, Tensor, TensorData};
+use lang_common::*;
+use std::time::Instant;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn time(runs: usize, mut f: impl FnMut()) -> f64 {
+    f();
+    median(
+        (0..runs)
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64() * 1e6
+            })
+            .collect(),
+    )
+}
+
+#[test]
+#[ignore]
+fn bench_programs() {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("programs");
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    files.sort();
+    println!(
+        "| program | stmts | ops | eval B=1 µs | eval+grad B=1 µs | eval B=32 µs | eval+grad B=32 µs |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for path in files {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let prog = program(&std::fs::read_to_string(&path).unwrap());
+        let m = motion(prog.people().len(), 196);
+        let (one, [_, people, frames, j, c]) = flat(&m);
+        let mut row = Vec::new();
+        for batch in [1usize, 32] {
+            let data: Vec<f32> = (0..batch).flat_map(|_| one.iter().copied()).collect();
+            let shape = [batch, people, frames, j, c];
+            let runs = if batch == 1 { 50 } else { 10 };
+            let plain = Device::flex();
+            let x = Tensor::<5>::from_data(TensorData::new(data.clone(), shape), &plain);
+            let eval_us = time(runs, || {
+                let e = prog.evaluate(x.clone());
+                let _ = e.total.into_data();
+            });
+            let ad = Device::flex().autodiff();
+            let grad_us = time(runs, || {
+                let x = Tensor::<5>::from_data(TensorData::new(data.clone(), shape), &ad)
+                    .require_grad();
+                let e = prog.evaluate(x.clone());
+                let g = e.total.sum().backward();
+                let _ = x.grad(&g).unwrap().into_data();
+            });
+            row.push((eval_us, grad_us));
+        }
+        println!(
+            "| {name} | {} | {} | {:.0} | {:.0} | {:.0} | {:.0} |",
+            prog.statements().len(),
+            prog.cost_estimate().ops,
+            row[0].0,
+            row[0].1,
+            row[1].0,
+            row[1].1
+        );
+    }
+}
