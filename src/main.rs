@@ -34,6 +34,9 @@ enum Command {
     Score(cli::score::ScoreArgs),
     /// Check `.mprog` programs and print their diagnostics.
     Check(cli::check::CheckArgs),
+    /// Evaluate a model against real test clips (metrics, FID, R-precision), or train
+    /// the evaluator (`mprog eval train-encoder`).
+    Eval(cli::eval::EvalArgs),
 }
 
 fn main() -> miette::Result<()> {
@@ -52,6 +55,7 @@ fn main() -> miette::Result<()> {
                 std::process::exit(1);
             }
         }
+        Command::Eval(args) => cli::eval::run(args)?,
     }
     Ok(())
 }

@@ -4,6 +4,7 @@ pub mod bench;
 pub mod check;
 pub mod convert;
 pub mod data;
+pub mod eval;
 pub mod generate;
 pub mod io;
 pub mod score;
