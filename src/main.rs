@@ -32,6 +32,13 @@ enum Command {
     Train(cli::train::TrainArgs),
     /// Check `.mprog` programs and print their diagnostics.
     Check(cli::check::CheckArgs),
+    /// Interactive session: type constraints, score them on a motion, see gradients.
+    Repl(cli::repl::ReplArgs),
+    /// Print a self-contained system prompt for an LLM that writes `.mprog` programs.
+    Prompt,
+    /// Generate documentation pages (the library reference, the cookbook).
+    #[command(subcommand)]
+    Doc(cli::doc::DocCommand),
 }
 
 fn main() -> miette::Result<()> {
@@ -44,6 +51,9 @@ fn main() -> miette::Result<()> {
         Command::Render(args) => cli::convert::render(args)?,
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
+        Command::Repl(args) => cli::repl::run(args)?,
+        Command::Prompt => print!("{}", mprog::docgen::prompt::system_prompt()),
+        Command::Doc(cmd) => cli::doc::run(cmd)?,
         Command::Check(args) => {
             if !cli::check::run(&args)? {
                 std::process::exit(1);

@@ -7,3 +7,5 @@ pub mod convert;
 pub mod io;
 pub mod check;
 pub mod generate;
+pub mod repl;
+pub mod doc;

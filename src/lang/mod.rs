@@ -19,7 +19,7 @@ pub mod syntax;
 
 pub use check::{Header, ParamInfo, PersonInfo};
 pub use diag::{Diagnostic, Diagnostics, Severity};
-pub use eval::{EvalError, Evaluation};
+pub use eval::{EvalError, Evaluation, FrameErrors};
 pub use ir::CostEstimate;
 
 use burn::tensor::Tensor;
@@ -109,6 +109,12 @@ impl Program {
     /// Errors of a batch of motions, or why the tensor does not fit.
     pub fn try_evaluate(&self, joints: Tensor<5>) -> Result<Evaluation, EvalError> {
         eval::evaluate(&self.checked.ir, joints, &self.cache)
+    }
+
+    /// Each statement's error per frame (host values, no gradient), in statement order:
+    /// what [`Program::evaluate`] averages.
+    pub fn evaluate_frames(&self, joints: Tensor<5>) -> Result<Vec<FrameErrors>, EvalError> {
+        eval::evaluate_frames(&self.checked.ir, joints, &self.cache)
     }
 
     /// The statements, in the column order of [`Evaluation::per_statement`].

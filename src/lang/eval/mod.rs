@@ -7,7 +7,10 @@
 //! * every node `[batch or 1, frames of its domain or 1, lanes or 1, channels]`;
 //! * output `total [batch]`, `per_statement [batch, statements]`.
 
+mod frames;
 mod ops;
+
+pub use frames::{FrameErrors, evaluate_frames};
 
 use crate::lang::ir::*;
 use crate::skeleton::NUM_JOINTS;
@@ -119,6 +122,32 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
 
 /// Evaluates `ir` on joint positions `[batch, people, frames, 22, 3]`.
 pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evaluation, EvalError> {
+    with_node_values(ir, joints, cache, |values, idx, batch, device| {
+        let mut columns = Vec::with_capacity(ir.statements.len());
+        for s in &ir.statements {
+            columns.push(statement_error(ir, s, values, idx, batch, device));
+        }
+        let per_statement = if columns.len() == 1 {
+            columns.remove(0)
+        } else {
+            Tensor::cat(columns, 1)
+        };
+        let total = per_statement.clone().sum_dim(1).reshape([batch]);
+        Evaluation {
+            total,
+            per_statement,
+        }
+    })
+}
+
+/// Checks the input, computes every node, and hands the values the statements read to
+/// `reduce` (with the index cache, the batch size and the device).
+fn with_node_values<T>(
+    ir: &Ir,
+    joints: Tensor<5>,
+    cache: &IndexCache,
+    reduce: impl FnOnce(&[Option<Tensor<4>>], &CachedIndices, usize, &burn::tensor::Device) -> T,
+) -> Result<T, EvalError> {
     let [batch, people, frames, nj, nc] = joints.dims();
     if people != ir.people || nj != NUM_JOINTS || nc != 3 || frames == 0 || batch == 0 {
         return Err(EvalError::BadShape {
@@ -205,21 +234,9 @@ pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evalua
             }
         }
     }
-    let mut columns = Vec::with_capacity(ir.statements.len());
-    for s in &ir.statements {
-        columns.push(statement_error(ir, s, &values, idx, batch, &device));
-    }
+    let out = reduce(&values, idx, batch, &device);
     drop(guard);
-    let per_statement = if columns.len() == 1 {
-        columns.remove(0)
-    } else {
-        Tensor::cat(columns, 1)
-    };
-    let total = per_statement.clone().sum_dim(1).reshape([batch]);
-    Ok(Evaluation {
-        total,
-        per_statement,
-    })
+    Ok(out)
 }
 
 /// For each node, the last node that reads it (statements count as reading at the end).
