@@ -76,7 +76,7 @@ fn joints_section() -> String {
     let rest = rest_pose();
     let mut s = String::from("| index | joint | aliases | rest height (m) |\n| --- | --- | --- | --- |\n");
     for (i, name) in JOINT_NAMES.iter().enumerate() {
-        let aliases: Vec<&str> = ALIASES.iter().filter(|(_, j)| *j == i).map(|(a, _)| *a).collect();
+        let aliases: Vec<String> = ALIASES.iter().filter(|(_, j)| *j == i).map(|(a, _)| format!("`{a}`")).collect();
         s.push_str(&format!("| {i} | `{name}` | {} | {:.2} |\n", aliases.join(", "), rest[i].y));
     }
     s

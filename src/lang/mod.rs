@@ -8,7 +8,7 @@
 //!
 //! [`compile`] runs the first two stages and returns a [`Program`]; [`check_source`]
 //! returns every diagnostic (errors and warnings) for `mprog check`. The language itself
-//! is described in `docs/language.md` (syntax, semantics, the scale of the total error).
+//! is described in `book/src/reference/language.md` (the book) (syntax, semantics, the scale of the total error).
 
 pub mod check;
 pub mod diag;
