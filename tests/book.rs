@@ -67,7 +67,8 @@ fn check_block(page: &Path, b: &CodeBlock) -> Result<(), String> {
 }
 
 /// A transcript: `mprog> input` lines (continuations start with `  ...> `) and the
-/// expected output. A line ending in `…` matches any line starting with the rest.
+/// expected output. A line ending in `…` matches any line starting with the rest; a
+/// last line of just `…` matches whatever follows.
 fn replay(what: &str, transcript: &str) -> Result<(), String> {
     let mut session = mprog::repl::Session::new(None);
     let mut lines = transcript.lines().peekable();
@@ -89,8 +90,11 @@ fn replay(what: &str, transcript: &str) -> Result<(), String> {
         // Tests run in the package root, like a reader of the book in a checkout.
         let got = session.handle(&input).render(false);
         let got: Vec<&str> = got.lines().collect();
-        let ok = got.len() == expected.len()
-            && got.iter().zip(&expected).all(|(g, e)| match e.strip_suffix('…') {
+        // A last expected line of just `…` matches the rest of the output.
+        let open_end = expected.last().is_some_and(|l| l.trim() == "…");
+        let fixed = if open_end { &expected[..expected.len() - 1] } else { &expected[..] };
+        let ok = (got.len() == fixed.len() || (open_end && got.len() >= fixed.len()))
+            && got.iter().zip(fixed).all(|(g, e)| match e.strip_suffix('…') {
                 Some(prefix) => g.starts_with(prefix),
                 None => g.trim_end() == e.trim_end(),
             });

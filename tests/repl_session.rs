@@ -114,7 +114,7 @@ fn eval_explains_bad_input() {
     let mut s = session();
     let out = fails(&mut s, ":eval head.w");
     assert!(out.contains("mprog::unknown_component") && !out.contains("not_a_constraint"), "{out}");
-    let none = fails(&mut s, ":eval let x = 3");
+    let none = fails(&mut s, ":eval let q = 3");
     assert!(none.contains("nothing to evaluate"), "{none}");
     let mut empty = Session::new(None);
     assert!(fails(&mut empty, ":eval head.y").contains("no current motion"));

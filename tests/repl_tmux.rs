@@ -91,16 +91,17 @@ fn a_person_uses_the_repl_in_a_terminal() {
         env!("CARGO_BIN_EXE_mprog")
     );
     tmux.run(&["new-session", "-d", "-s", "repl", "-x", "160", "-y", "60", &cmd]);
-    tmux.wait_for("mprog> ");
+    tmux.wait_for("mprog>");
     tmux.wait_for("40 frames");
 
-    // A statement over several lines: the prompt changes while the brace is open.
+    // A statement over several lines: Enter inside an open brace continues the input.
     tmux.line("length 2s");
     tmux.line("always {");
-    tmux.wait_for("...> ");
     tmux.line("head.y > 1.8 m");
     tmux.line("}");
     tmux.wait_for("line 3: head.y > 1.8 m");
+    tmux.line(":show");
+    tmux.wait_for("  4 │ }");
 
     // A trailing operator continues the line too.
     tmux.line(":eval pelvis.z >");

@@ -122,7 +122,7 @@ with one complete program in a ```mprog code block, and nothing the language lac
 prompt "a person walks forward"        # text for the motion model (one person)
 length 6s                              # or: length 120 frames
 param d = 40 cm                        # named constant, overridable from the command line
-let mid = midPoint(l_hand, r_hand)     # named expression, re-evaluated where used
+let grip = midPoint(l_hand, r_hand)    # named expression, re-evaluated where used
 def near(p, q, r) = dist(p, q) < r     # function (inlined; no recursion)
 
 always { near(l_hand, r_hand, d) }     # every frame (top-level statements are `always` too)

@@ -63,7 +63,10 @@ pub fn compile_probe(session: &Session, text: &str) -> Result<Probe, Reply> {
         .iter()
         .filter(|i| i.severity == crate::lang::Severity::Error)
         .all(|i| i.code == "mprog::not_a_constraint");
-    if !only_not_constraint || !real_errors(&as_statement) {
+    if !real_errors(&as_statement) {
+        return Err(Reply::error("nothing to evaluate: the input has no constraint or value"));
+    }
+    if !only_not_constraint {
         return Err(Reply::diagnostics(visible(without_not_constraint(as_statement))));
     }
     match attempt(format!("minimize ({text})"), Kind::Scalar) {
@@ -308,7 +311,7 @@ pub fn score(session: &Session) -> Reply {
         Err(d) => return Reply::diagnostics(d),
     };
     let cols = 0..program.statements().len();
-    match score_lines(&program, cols, m, session.device()) {
+    match score_lines(&program, cols, m, session.device(), true) {
         Ok(lines) => Reply::text(lines),
         Err(e) => Reply::error(e),
     }
@@ -324,13 +327,19 @@ pub fn score_new(session: &Session, start: usize, reply: &mut Reply) {
     if first == infos.len() {
         return;
     }
-    match score_lines(&program, first..infos.len(), m, session.device()) {
+    match score_lines(&program, first..infos.len(), m, session.device(), false) {
         Ok(lines) => reply.push(Item::Text(lines)),
         Err(e) => reply.push(Item::Warning(e)),
     }
 }
 
-fn score_lines(program: &Program, cols: Range<usize>, m: &CurrentMotion, device: &Device) -> Result<String, String> {
+fn score_lines(
+    program: &Program,
+    cols: Range<usize>,
+    m: &CurrentMotion,
+    device: &Device,
+    with_total: bool,
+) -> Result<String, String> {
     let x = joints_tensor(m, program.people().len(), device)?;
     let ev = program.try_evaluate(x.clone()).map_err(|e| e.to_string())?;
     let frames = program.evaluate_frames(x).map_err(|e| e.to_string())?;
@@ -346,7 +355,7 @@ fn score_lines(program: &Program, cols: Range<usize>, m: &CurrentMotion, device:
         let spark = sparkline(&merge(std::slice::from_ref(&frames[i]), f), 24);
         out.push(format!("  {label:width$}  {:>9} {:<5}{weight}  {spark}", num(per[i]), s.unit));
     }
-    if cols.len() == infos.len() {
+    if with_total {
         let total: f32 = per.iter().sum();
         out.push(format!("  total {} on {} ({f} frames)", num(total), m.origin));
     }
