@@ -11,12 +11,14 @@
 //! | language | [`lang`] | source → AST → checked IR → burn error graph |
 //! | solvers | [`solve`] | error graph + prompts → guided / optimised motions |
 //! | pictures | [`render`] | motions, curves → GIF / PNG |
+//! | interfaces | [`repl`], [`docgen`] | interactive sessions; LLM prompt card, book pages |
 //!
 //! Conventions everywhere: HumanML3D 22-joint skeleton ([`skeleton`]), metres, Y up,
 //! 20 fps; tensors of joint positions are `[batch, people, frames, 22, 3]`.
 
 pub mod dataset;
 pub mod eval;
+pub mod docgen;
 pub mod features;
 pub mod formats;
 pub mod fsutil;
@@ -24,5 +26,6 @@ pub mod lang;
 pub mod model;
 pub mod motion;
 pub mod render;
+pub mod repl;
 pub mod skeleton;
 pub mod solve;

@@ -37,6 +37,13 @@ enum Command {
     /// Evaluate a model against real test clips (metrics, FID, R-precision), or train
     /// the evaluator (`mprog eval train-encoder`).
     Eval(cli::eval::EvalArgs),
+    /// Interactive session: type constraints, score them on a motion, see gradients.
+    Repl(cli::repl::ReplArgs),
+    /// Print a self-contained system prompt for an LLM that writes `.mprog` programs.
+    Prompt,
+    /// Generate documentation pages (the library reference, the cookbook).
+    #[command(subcommand)]
+    Doc(cli::doc::DocCommand),
 }
 
 fn main() -> miette::Result<()> {
@@ -50,6 +57,9 @@ fn main() -> miette::Result<()> {
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
         Command::Score(args) => cli::score::run(args)?,
+        Command::Repl(args) => cli::repl::run(args)?,
+        Command::Prompt => print!("{}", mprog::docgen::prompt::system_prompt()),
+        Command::Doc(cmd) => cli::doc::run(cmd)?,
         Command::Check(args) => {
             if !cli::check::run(&args)? {
                 std::process::exit(1);

@@ -9,3 +9,5 @@ pub mod generate;
 pub mod io;
 pub mod score;
 pub mod train;
+pub mod repl;
+pub mod doc;

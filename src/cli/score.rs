@@ -4,7 +4,7 @@
 use super::io::load_people;
 use burn::prelude::*;
 use miette::{IntoDiagnostic, Result, miette};
-use mprog::lang::{Program, StatementTrace};
+use mprog::lang::{FrameErrors, Program};
 use mprog::motion::Motion;
 use mprog::render::{PlotOptions, Series, plot_lines};
 use std::path::PathBuf;
@@ -63,7 +63,8 @@ pub fn run(args: ScoreArgs) -> Result<()> {
     }
     let device = Device::flex();
     let joints = people_tensor(&people, &device);
-    let (evaluation, traces) = program.evaluate_traced(joints).into_diagnostic()?;
+    let evaluation = program.try_evaluate(joints.clone()).into_diagnostic()?;
+    let traces = program.evaluate_frames(joints).into_diagnostic()?;
     let per = evaluation
         .per_statement
         .into_data()
@@ -88,7 +89,7 @@ pub fn run(args: ScoreArgs) -> Result<()> {
     Ok(())
 }
 
-fn plot_traces(program: &Program, traces: &[StatementTrace], path: &std::path::Path) -> Result<()> {
+fn plot_traces(program: &Program, traces: &[FrameErrors], path: &std::path::Path) -> Result<()> {
     let series: Vec<Series> = program
         .statements()
         .iter()
@@ -98,8 +99,10 @@ fn plot_traces(program: &Program, traces: &[StatementTrace], path: &std::path::P
             points: t
                 .frames
                 .iter()
-                .zip(&t.values)
-                .map(|(&f, &v)| (f as f32 / 20.0, v))
+                .zip(&t.errors[0])
+                .zip(&t.applies[0])
+                .filter(|(_, a)| **a)
+                .map(|((&f, &v), _)| (f as f32 / 20.0, v))
                 .collect(),
         })
         .collect();

@@ -8,7 +8,7 @@
 //!
 //! [`compile`] runs the first two stages and returns a [`Program`]; [`check_source`]
 //! returns every diagnostic (errors and warnings) for `mprog check`. The language itself
-//! is described in `docs/language.md` (syntax, semantics, the scale of the total error).
+//! is described in `book/src/reference/language.md` (the book) (syntax, semantics, the scale of the total error).
 
 pub mod check;
 pub mod diag;
@@ -19,7 +19,7 @@ pub mod syntax;
 
 pub use check::{Header, ParamInfo, PersonInfo};
 pub use diag::{Diagnostic, Diagnostics, Severity};
-pub use eval::{EvalError, Evaluation, StatementTrace};
+pub use eval::{EvalError, Evaluation, FrameErrors};
 pub use ir::CostEstimate;
 
 use burn::tensor::Tensor;
@@ -111,12 +111,10 @@ impl Program {
         eval::evaluate(&self.checked.ir, joints, &self.cache)
     }
 
-    /// Errors of a batch of motions and every statement's error frame by frame.
-    pub fn evaluate_traced(
-        &self,
-        joints: Tensor<5>,
-    ) -> Result<(Evaluation, Vec<StatementTrace>), EvalError> {
-        eval::evaluate_traced(&self.checked.ir, joints, &self.cache)
+    /// Each statement's error per frame (host values, no gradient), in statement order:
+    /// what [`Program::evaluate`] averages.
+    pub fn evaluate_frames(&self, joints: Tensor<5>) -> Result<Vec<FrameErrors>, EvalError> {
+        eval::evaluate_frames(&self.checked.ir, joints, &self.cache)
     }
 
     /// The statements, in the column order of [`Evaluation::per_statement`].

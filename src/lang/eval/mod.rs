@@ -7,7 +7,10 @@
 //! * every node `[batch or 1, frames of its domain or 1, lanes or 1, channels]`;
 //! * output `total [batch]`, `per_statement [batch, statements]`.
 
+mod frames;
 mod ops;
+
+pub use frames::{FrameErrors, evaluate_frames};
 
 use crate::lang::ir::*;
 use crate::skeleton::NUM_JOINTS;
@@ -21,17 +24,6 @@ pub struct Evaluation {
     pub total: Tensor<1>,
     /// Each statement's weighted mean error `[batch, statements]`.
     pub per_statement: Tensor<2>,
-}
-
-/// One statement's error frame by frame (for plots and the viewer's timeline).
-#[derive(Clone, Debug, PartialEq)]
-pub struct StatementTrace {
-    /// Frames the statement applies to (its time block).
-    pub frames: Vec<usize>,
-    /// `[batch, frames.len()]` weighted error per frame (summed over loop lanes); NaN where
-    /// an `if` condition excludes the frame. Their mean over non-NaN frames is the
-    /// statement's column of [`Evaluation::per_statement`].
-    pub values: Vec<f32>,
 }
 
 /// Why a tensor cannot be evaluated.
@@ -130,24 +122,32 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
 
 /// Evaluates `ir` on joint positions `[batch, people, frames, 22, 3]`.
 pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evaluation, EvalError> {
-    evaluate_inner(ir, joints, cache, false).map(|(e, _)| e)
+    with_node_values(ir, joints, cache, |values, idx, batch, device| {
+        let mut columns = Vec::with_capacity(ir.statements.len());
+        for s in &ir.statements {
+            columns.push(statement_error(ir, s, values, idx, batch, device));
+        }
+        let per_statement = if columns.len() == 1 {
+            columns.remove(0)
+        } else {
+            Tensor::cat(columns, 1)
+        };
+        let total = per_statement.clone().sum_dim(1).reshape([batch]);
+        Evaluation {
+            total,
+            per_statement,
+        }
+    })
 }
 
-/// Like [`evaluate`], plus every statement's error frame by frame (read back to the host).
-pub fn evaluate_traced(
+/// Checks the input, computes every node, and hands the values the statements read to
+/// `reduce` (with the index cache, the batch size and the device).
+fn with_node_values<T>(
     ir: &Ir,
     joints: Tensor<5>,
     cache: &IndexCache,
-) -> Result<(Evaluation, Vec<StatementTrace>), EvalError> {
-    evaluate_inner(ir, joints, cache, true)
-}
-
-fn evaluate_inner(
-    ir: &Ir,
-    joints: Tensor<5>,
-    cache: &IndexCache,
-    traced: bool,
-) -> Result<(Evaluation, Vec<StatementTrace>), EvalError> {
+    reduce: impl FnOnce(&[Option<Tensor<4>>], &CachedIndices, usize, &burn::tensor::Device) -> T,
+) -> Result<T, EvalError> {
     let [batch, people, frames, nj, nc] = joints.dims();
     if people != ir.people || nj != NUM_JOINTS || nc != 3 || frames == 0 || batch == 0 {
         return Err(EvalError::BadShape {
@@ -234,72 +234,9 @@ fn evaluate_inner(
             }
         }
     }
-    let mut columns = Vec::with_capacity(ir.statements.len());
-    let mut traces = Vec::new();
-    for s in &ir.statements {
-        columns.push(statement_error(ir, s, &values, idx, batch, &device));
-        if traced {
-            traces.push(statement_trace(ir, s, &values, batch, frames));
-        }
-    }
+    let out = reduce(&values, idx, batch, &device);
     drop(guard);
-    let per_statement = if columns.len() == 1 {
-        columns.remove(0)
-    } else {
-        Tensor::cat(columns, 1)
-    };
-    let total = per_statement.clone().sum_dim(1).reshape([batch]);
-    Ok((
-        Evaluation {
-            total,
-            per_statement,
-        },
-        traces,
-    ))
-}
-
-/// Frame-by-frame error of one statement, on the host.
-fn statement_trace(
-    ir: &Ir,
-    s: &Statement,
-    values: &[Option<Tensor<4>>],
-    batch: usize,
-    frames: usize,
-) -> StatementTrace {
-    let ts = ir.resolve_domain(s.domain, frames);
-    if ts.is_empty() {
-        return StatementTrace {
-            frames: ts,
-            values: Vec::new(),
-        };
-    }
-    let err = values[s.error].clone().expect("statement error is kept");
-    let mask = s.mask.and_then(|m| values[m].clone());
-    let lanes = err.dims()[2].max(mask.as_ref().map_or(1, |m| m.dims()[2]));
-    let factor = (s.weight * (s.lanes / lanes.max(1)) as f64) as f32;
-    let d = ts.len();
-    let host = |t: Tensor<4>| -> Vec<f32> {
-        // [b, |D| or 1, K or 1, 1] → [batch, |D|, K] → Σ over lanes → [batch, |D|]
-        let [b, f, k, _] = t.dims();
-        let t = t.reshape([b, f, k]).expand([batch, d, lanes]).sum_dim(2);
-        t.into_data()
-            .convert::<f32>()
-            .try_into_vec::<f32>()
-            .unwrap_or_default()
-    };
-    let (sum, covered) = match mask {
-        Some(m) => (host(err * m.clone()), Some(host(m))),
-        None => (host(err), None),
-    };
-    let values = sum
-        .iter()
-        .enumerate()
-        .map(|(i, v)| match &covered {
-            Some(c) if c[i] == 0.0 => f32::NAN,
-            _ => v * factor,
-        })
-        .collect();
-    StatementTrace { frames: ts, values }
+    Ok(out)
 }
 
 /// For each node, the last node that reads it (statements count as reading at the end).

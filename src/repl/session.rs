@@ -1,0 +1,341 @@
+//! The REPL backend: a [`Session`] holds the program typed or loaded so far, the current
+//! motion and the model bundle, and answers one input at a time with a [`Reply`]. It
+//! knows nothing of terminals, so tests drive it directly.
+//!
+//! Adding a command (the solver's `:run` will be one) means: a variant in
+//! [`super::command::Command`] and its row in `COMMANDS`, and a method here that reads
+//! [`Session::program`], [`Session::motion`] and [`Session::bundle`] and hands a result to
+//! [`Session::set_motion`].
+
+use super::command::{self, Command, Input};
+use super::probe;
+use super::reply::{Item, Reply};
+use crate::features::recover_from_ric;
+use crate::formats::{LoadedMotion, read_motion};
+use crate::lang::{Diagnostics, Program, Severity, compile};
+use crate::model::ModelBundle;
+use crate::model::generate::{GenerateRequest, generate};
+use crate::model::sampler::SamplerKind;
+use crate::motion::Motion;
+use crate::render::{RenderOptions, render_to_path};
+use crate::skeleton::FPS;
+use burn::tensor::Device;
+use std::path::{Path, PathBuf};
+
+/// Name the session's program has in diagnostics.
+pub const SOURCE_NAME: &str = "<repl>";
+
+/// Diagnostics the REPL does not show: a session starts with no length and no
+/// constraints, and that is fine until a motion is scored.
+const QUIET: &[&str] = &["mprog::missing_length", "mprog::empty_program"];
+
+/// The motion commands work on.
+#[derive(Clone, Debug)]
+pub struct CurrentMotion {
+    /// One motion per person, all at 20 fps.
+    pub people: Vec<Motion>,
+    /// Where it came from (file name, or the `:gen` request).
+    pub origin: String,
+}
+
+impl CurrentMotion {
+    /// Frames shared by every person.
+    pub fn frames(&self) -> usize {
+        self.people.iter().map(Motion::len).min().unwrap_or(0)
+    }
+}
+
+/// One REPL session.
+pub struct Session {
+    program: String,
+    motion: Option<CurrentMotion>,
+    model_dir: Option<PathBuf>,
+    bundle: Option<ModelBundle>,
+    device: Device,
+}
+
+impl Session {
+    /// A session with no program and no motion; `:gen` loads the bundle in `model_dir`.
+    pub fn new(model_dir: Option<PathBuf>) -> Self {
+        Session {
+            program: String::new(),
+            motion: None,
+            model_dir,
+            bundle: None,
+            device: Device::flex(),
+        }
+    }
+
+    /// Answers one (possibly multi-line) input.
+    pub fn handle(&mut self, text: &str) -> Reply {
+        match command::parse(text) {
+            Err(e) => Reply::error(e),
+            Ok(Input::Empty) => Reply::default(),
+            Ok(Input::Code(code)) => self.add_code(&code),
+            Ok(Input::Command(c)) => self.run_command(c),
+        }
+    }
+
+    /// Runs one command.
+    pub fn run_command(&mut self, c: Command) -> Reply {
+        match c {
+            Command::Load(path) => self.load(&path),
+            Command::Motion(path) => self.load_motion(&path),
+            Command::Gen {
+                prompt,
+                seconds,
+                seed,
+            } => self.gen_motion(&prompt, seconds, seed),
+            Command::Eval(text) => probe::eval(self, &text),
+            Command::Grad(text) => probe::grad(self, &text),
+            Command::Score => probe::score(self),
+            Command::Render(path) => self.render(&path),
+            Command::Show => Reply::text(self.show()),
+            Command::Clear => {
+                self.program.clear();
+                Reply::text("program cleared")
+            }
+            Command::Help(topic) => help(topic.as_deref()),
+            Command::Quit => Reply {
+                items: Vec::new(),
+                quit: true,
+            },
+        }
+    }
+
+    /// The session's program source.
+    pub fn source(&self) -> &str {
+        &self.program
+    }
+
+    /// The session's program compiled, or its diagnostics (an empty session has none).
+    pub fn program(&self) -> Result<Program, Diagnostics> {
+        compile(&self.program, SOURCE_NAME, &[])
+    }
+
+    /// The current motion.
+    pub fn motion(&self) -> Option<&CurrentMotion> {
+        self.motion.as_ref()
+    }
+
+    /// Makes `people` the current motion (resampled to 20 fps).
+    pub fn set_motion(&mut self, people: Vec<Motion>, origin: impl Into<String>) {
+        let people = people
+            .into_iter()
+            .map(|m| if (m.fps - FPS).abs() > 1e-3 { m.resample(FPS) } else { m })
+            .collect();
+        self.motion = Some(CurrentMotion {
+            people,
+            origin: origin.into(),
+        });
+    }
+
+    /// The model bundle, loaded on first use.
+    pub fn bundle(&mut self) -> Result<&ModelBundle, String> {
+        if self.bundle.is_none() {
+            let Some(dir) = self.model_dir.clone() else {
+                return Err("no model bundle: start the REPL with `--model DIR`".into());
+            };
+            let b = ModelBundle::load(&dir, &self.device).map_err(|e| {
+                format!(
+                    "cannot load the model bundle in {}: {e} (train one with `mprog train`, or pass --model DIR)",
+                    dir.display()
+                )
+            })?;
+            self.bundle = Some(b);
+        }
+        Ok(self.bundle.as_ref().expect("loaded above"))
+    }
+
+    /// The device tensors are evaluated on.
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// Adds code to the program if the whole still checks; otherwise shows why.
+    fn add_code(&mut self, code: &str) -> Reply {
+        let start = self.program.len();
+        let candidate = format!("{}{code}\n", self.program);
+        let diags = visible(crate::lang::check_source(&candidate, SOURCE_NAME, &[]));
+        if diags.has_errors() {
+            return Reply::diagnostics(diags);
+        }
+        self.program = candidate;
+        let mut reply = Reply::default();
+        let fresh: Vec<_> = diags
+            .items
+            .iter()
+            .filter(|d| d.span.start >= start)
+            .cloned()
+            .collect();
+        if !fresh.is_empty() {
+            reply.push(Item::Diagnostics(Diagnostics::new(
+                SOURCE_NAME,
+                diags.source.clone(),
+                fresh,
+            )));
+        }
+        if self.motion.is_some() {
+            probe::score_new(self, start, &mut reply);
+        }
+        reply
+    }
+
+    fn load(&mut self, path: &Path) -> Reply {
+        let text = match std::fs::read_to_string(path) {
+            Ok(t) => t,
+            Err(e) => return Reply::error(format!("cannot read {}: {e}", path.display())),
+        };
+        let name = path.display().to_string();
+        let diags = crate::lang::check_source(&text, &name, &[]);
+        if diags.has_errors() {
+            let mut r = Reply::diagnostics(diags);
+            r.push(Item::Error(format!("{name} not loaded; the session's program is unchanged")));
+            return r;
+        }
+        self.program = if text.ends_with('\n') { text } else { format!("{text}\n") };
+        let mut reply = Reply::default();
+        if diags.warnings().next().is_some() {
+            reply.push(Item::Diagnostics(diags));
+        }
+        let lines = self.program.lines().count();
+        reply.push(Item::Text(format!("loaded {name} ({lines} lines); `:show` prints it, `:score` scores it")));
+        reply
+    }
+
+    fn load_motion(&mut self, path: &Path) -> Reply {
+        let name = path.display().to_string();
+        let people = match read_motion(path) {
+            Err(e) => return Reply::error(e.to_string()),
+            Ok(LoadedMotion::Joints { people, .. }) => people.into_iter().map(|p| p.motion).collect(),
+            Ok(LoadedMotion::Features(array)) => match recover_from_ric(&array.data) {
+                Ok(m) => vec![m],
+                Err(e) => return Reply::error(format!("{name}: recovering joints from HumanML3D features: {e}")),
+            },
+        };
+        self.set_motion(people, name);
+        Reply::text(self.describe_motion())
+    }
+
+    fn gen_motion(&mut self, prompt: &str, seconds: f32, seed: u64) -> Reply {
+        let frames = (seconds * FPS).round() as usize;
+        let req = GenerateRequest {
+            prompts: vec![prompt.to_string()],
+            frames,
+            seed,
+            sampler: SamplerKind::Ddim(50),
+            guidance_scale: 2.5,
+        };
+        let device = self.device.clone();
+        let out = match self.bundle() {
+            Err(e) => return Reply::error(e),
+            Ok(bundle) => generate(bundle, &req, &device, |_, _| {}),
+        };
+        match out {
+            Err(e) => Reply::error(format!("generation failed: {e}")),
+            Ok(g) => {
+                let unknown = g.unknown_words.first().cloned().unwrap_or_default();
+                self.set_motion(g.motions, format!("gen \"{prompt}\" {seconds}s seed {seed}"));
+                let mut r = Reply::text(self.describe_motion());
+                if !unknown.is_empty() {
+                    r.push(Item::Warning(format!("the model does not know: {}", unknown.join(", "))));
+                }
+                r
+            }
+        }
+    }
+
+    fn render(&self, path: &Path) -> Reply {
+        let Some(m) = &self.motion else {
+            return Reply::error(NO_MOTION);
+        };
+        let title = self
+            .program()
+            .ok()
+            .and_then(|p| p.prompt().map(str::to_string))
+            .unwrap_or_else(|| m.origin.clone());
+        match render_to_path(&m.people, &RenderOptions::titled(title), path) {
+            Ok(()) => Reply::text(format!("wrote {}", path.display())),
+            Err(e) => Reply::error(format!("cannot render {}: {e}", path.display())),
+        }
+    }
+
+    fn describe_motion(&self) -> String {
+        match &self.motion {
+            None => "no motion".into(),
+            Some(m) => {
+                let f = m.frames();
+                let people = m.people.len();
+                format!(
+                    "motion: {} — {} person{}, {f} frames ({:.2} s at 20 fps)",
+                    m.origin,
+                    people,
+                    if people == 1 { "" } else { "s" },
+                    f as f32 / FPS
+                )
+            }
+        }
+    }
+
+    fn show(&self) -> String {
+        if self.program.trim().is_empty() {
+            return "(the program is empty: type statements, or `:load FILE`)".into();
+        }
+        self.program
+            .lines()
+            .enumerate()
+            .map(|(i, l)| format!("{:3} │ {l}", i + 1))
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+}
+
+/// Message when a command needs a motion.
+pub const NO_MOTION: &str = "no current motion: `:motion FILE` loads one, `:gen \"PROMPT\"` generates one";
+
+/// Drops the diagnostics the REPL keeps quiet about.
+pub fn visible(d: Diagnostics) -> Diagnostics {
+    let items = d
+        .items
+        .into_iter()
+        .filter(|i| !QUIET.contains(&i.code))
+        .collect();
+    Diagnostics::new(&d.name, d.source, items)
+}
+
+/// True when `d` holds an error other than the quiet ones.
+pub fn real_errors(d: &Diagnostics) -> bool {
+    d.items
+        .iter()
+        .any(|i| i.severity == Severity::Error && !QUIET.contains(&i.code))
+}
+
+fn help(topic: Option<&str>) -> Reply {
+    if let Some(t) = topic {
+        return match command::find(t) {
+            Some(c) => Reply::text(format!(":{} {}\n    {}{}", c.name, c.args, c.help, aliases(c))),
+            None => Reply::error(format!("no command `:{t}`")),
+        };
+    }
+    let mut s = String::from(
+        "Type mprog statements to add them to the session's program (a line continues while a\n\
+         bracket is open or it ends with an operator). Commands:\n",
+    );
+    for c in command::COMMANDS {
+        let head = format!(":{} {}", c.name, c.args);
+        s.push_str(&format!("  {head:34} {}{}\n", c.help, aliases(c)));
+    }
+    s.push_str("Tab completes joints, functions, keywords and commands; history is kept between sessions.");
+    Reply::text(s)
+}
+
+fn aliases(c: &command::CommandDoc) -> String {
+    if c.aliases.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " (also {})",
+            c.aliases.iter().map(|a| format!(":{a}")).collect::<Vec<_>>().join(", ")
+        )
+    }
+}

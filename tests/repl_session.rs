@@ -1,0 +1,211 @@
+//! The REPL backend without a terminal: a `Session` is fed inputs and its replies are
+//! checked against numbers computed by hand on a synthetic motion, and against
+//! `lang::check_source` for diagnostics.
+
+use burn::tensor::{Device, Tensor, TensorData};
+use glam::Vec3;
+use mprog::lang::{check_source, compile};
+use mprog::motion::Motion;
+use mprog::repl::Session;
+use mprog::skeleton::{NUM_JOINTS, rest_pose};
+
+const F: usize = 40;
+
+/// The rest pose walking forward 0.05 m per frame; the head rises 1 cm per frame.
+fn walk() -> Motion {
+    let rest = rest_pose();
+    Motion::new(
+        (0..F)
+            .map(|t| {
+                std::array::from_fn(|j| {
+                    let mut p = rest[j] + Vec3::new(0.0, 0.0, 0.05 * t as f32);
+                    if j == 15 {
+                        p.y += 0.01 * t as f32;
+                    }
+                    p
+                })
+            })
+            .collect(),
+    )
+}
+
+fn session() -> Session {
+    let mut s = Session::new(None);
+    s.set_motion(vec![walk()], "walk");
+    s
+}
+
+fn say(s: &mut Session, input: &str) -> String {
+    let r = s.handle(input);
+    assert!(!r.is_error(), "{input}:\n{}", r.render(false));
+    r.render(false)
+}
+
+fn fails(s: &mut Session, input: &str) -> String {
+    let r = s.handle(input);
+    assert!(r.is_error(), "{input} should fail:\n{}", r.render(false));
+    r.render(false)
+}
+
+#[test]
+fn statements_accumulate_and_clear() {
+    let mut s = session();
+    say(&mut s, "length 2s");
+    say(&mut s, "param bar = 1.5 m");
+    let added = say(&mut s, "head.y > bar");
+    assert!(added.contains("line 3: head.y > bar"), "{added}");
+    let shown = say(&mut s, ":show");
+    assert!(shown.contains("  1 │ length 2s") && shown.contains("  3 │ head.y > bar"), "{shown}");
+    say(&mut s, "always {\n  pelvis.z < 10 m\n}");
+    assert_eq!(s.program().unwrap().statements().len(), 2);
+    say(&mut s, ":clear");
+    assert_eq!(s.source(), "");
+    assert!(say(&mut s, ":show").contains("empty"));
+}
+
+#[test]
+fn wrong_code_is_rejected_with_the_checkers_diagnostics() {
+    let mut s = session();
+    say(&mut s, "length 2s");
+    let out = fails(&mut s, "r_hnad.y > 1");
+    let expected = check_source("length 2s\nr_hnad.y > 1\n", "<repl>", &[]).render_plain();
+    assert_eq!(out.trim_end(), expected.trim_end());
+    assert!(out.contains("did you mean `r_hand`?"));
+    assert_eq!(s.source(), "length 2s\n", "rejected code is not kept");
+}
+
+#[test]
+fn eval_of_a_scalar_summarises_frames() {
+    let mut s = session();
+    let rest = rest_pose();
+    let out = say(&mut s, ":eval head.y");
+    let lo = rest[15].y;
+    let hi = rest[15].y + 0.01 * (F - 1) as f32;
+    let mean = (lo + hi) / 2.0;
+    let want = format!("min {:.3}  mean {:.3}  max {:.3}", lo, mean, hi);
+    assert!(out.contains(&want), "{out}\nwant {want}");
+    assert!(out.contains('▁') && out.contains('█') && out.contains("frames 0–39"), "{out}");
+}
+
+#[test]
+fn eval_of_a_vector_shows_components() {
+    let mut s = session();
+    let out = say(&mut s, ":eval pelvis - pelvis@start");
+    assert!(out.contains("x  min 0  mean 0  max 0"), "{out}");
+    assert!(out.contains("z  min 0  mean 0.9750  max 1.950"), "{out}");
+}
+
+#[test]
+fn eval_of_a_statement_shows_its_error() {
+    let mut s = session();
+    // pelvis.z = 0.05 t: the error of `pelvis.z > 1 m` is max(1 − 0.05 t, 0).
+    let out = say(&mut s, ":eval pelvis.z > 1 m");
+    let want: f32 = (0..F).map(|t| (1.0 - 0.05 * t as f32).max(0.0)).sum::<f32>() / F as f32;
+    assert!(out.contains(&format!("error {want:.4} m")), "{out}\nwant {want}");
+    assert!(out.contains("zero at 20"), "{out}");
+    let end = say(&mut s, ":eval at end { pelvis.z > 3 m }");
+    assert!(end.contains("frame 39: 1.050"), "{end}");
+    let during = say(&mut s, ":eval during 10..20 { pelvis.z > 1 m }");
+    assert!(during.contains("frames 10–19") && !during.contains('·'), "{during}");
+}
+
+#[test]
+fn eval_explains_bad_input() {
+    let mut s = session();
+    let out = fails(&mut s, ":eval head.w");
+    assert!(out.contains("mprog::unknown_component") && !out.contains("not_a_constraint"), "{out}");
+    let none = fails(&mut s, ":eval let q = 3");
+    assert!(none.contains("nothing to evaluate"), "{none}");
+    let mut empty = Session::new(None);
+    assert!(fails(&mut empty, ":eval head.y").contains("no current motion"));
+}
+
+#[test]
+fn grad_ranks_the_joints_the_statement_moves() {
+    let mut s = session();
+    let out = say(&mut s, ":grad l_hand.y > 3 m");
+    let first = out.lines().nth(1).unwrap_or("");
+    assert!(first.trim_start().starts_with("left_wrist"), "{out}");
+    assert_eq!(out.lines().count(), 2, "only the left wrist moves:\n{out}");
+    let satisfied = say(&mut s, ":grad l_hand.y < 3 m");
+    assert!(satisfied.contains("gradient is zero"), "{satisfied}");
+    let two = say(&mut s, ":grad dist(l_hand, r_hand) < 10 cm");
+    assert!(two.contains("left_wrist") && two.contains("right_wrist"), "{two}");
+    assert!(fails(&mut s, ":grad l_hand").contains("vector"));
+}
+
+#[test]
+fn score_matches_program_evaluation() {
+    let mut s = session();
+    let src = "length 2s\nhead.y > 1.8 m\nat end { pelvis.z > 3 m }\nfor f in [l_foot, r_foot] { f.y < 1 cm }\n";
+    for line in src.lines() {
+        say(&mut s, line);
+    }
+    let out = say(&mut s, ":score");
+    let prog = compile(src, "x", &[]).unwrap();
+    let m = walk();
+    let x = Tensor::<5>::from_data(TensorData::new(m.to_flat(), [1, 1, F, NUM_JOINTS, 3]), &Device::flex());
+    let total = prog.evaluate(x).total.into_data().try_into_vec::<f32>().unwrap()[0];
+    let want = format!("total {} on walk", mprog::repl::summary::num(total));
+    assert!(out.contains(&want), "{out}\nwant {want}");
+    assert_eq!(out.lines().count(), 4, "{out}");
+}
+
+#[test]
+fn per_frame_errors_average_to_the_statement_errors() {
+    let src = "length 2s\nhead.y > 1.8 m\nif pelvis.z > 1 m { head.y > 1.9 m }\nduring 5..15 weight 2 { for f in [l_foot, r_foot] { f.y > 0.2 m } }\nat end { pelvis.z > 3 m }\n";
+    let prog = compile(src, "x", &[]).unwrap();
+    let m = walk();
+    let x = Tensor::<5>::from_data(TensorData::new(m.to_flat(), [1, 1, F, NUM_JOINTS, 3]), &Device::flex());
+    let per = prog.evaluate(x.clone()).per_statement.into_data().try_into_vec::<f32>().unwrap();
+    let frames = prog.evaluate_frames(x).unwrap();
+    assert_eq!(frames.len(), per.len());
+    for (i, fe) in frames.iter().enumerate() {
+        let vals: Vec<f32> = fe.errors[0].iter().zip(&fe.applies[0]).filter(|(_, a)| **a).map(|(v, _)| *v).collect();
+        let mean = vals.iter().sum::<f32>() / vals.len().max(1) as f32;
+        assert!((mean - per[i]).abs() < 1e-4, "statement {i}: per-frame mean {mean} vs {}", per[i]);
+    }
+    assert_eq!(frames[2].frames, (5..15).collect::<Vec<_>>());
+    assert_eq!(frames[1].applies[0].iter().filter(|a| **a).count(), 19, "pelvis.z > 1 from frame 21");
+}
+
+#[test]
+fn files_commands_and_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Session::new(Some(dir.path().join("no-model")));
+    assert!(fails(&mut s, ":motion /no/such/walk.bvh").contains("walk.bvh"));
+    let gen_err = fails(&mut s, ":gen \"a person walks\" 2");
+    assert!(gen_err.contains("cannot load the model bundle") && gen_err.contains("--model"), "{gen_err}");
+    let good = dir.path().join("good.mprog");
+    std::fs::write(&good, "length 2s\nhead.y > 1 m\n").unwrap();
+    let bad = dir.path().join("bad.mprog");
+    std::fs::write(&bad, "length 2s\nhead.q > 1 m\n").unwrap();
+    say(&mut s, &format!(":load {}", good.display()));
+    let out = fails(&mut s, &format!(":load {}", bad.display()));
+    assert!(out.contains("unknown_component") && out.contains("not loaded"), "{out}");
+    assert_eq!(s.source(), "length 2s\nhead.y > 1 m\n");
+    let npy = dir.path().join("walk.npy");
+    mprog::formats::write_motion(&npy, &[walk()], &mprog::formats::Meta::new()).unwrap();
+    assert!(say(&mut s, &format!(":motion {}", npy.display())).contains("40 frames"));
+    let png = dir.path().join("walk.png");
+    say(&mut s, &format!(":render {}", png.display()));
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    assert!(fails(&mut s, ":render out.txt").contains("out.txt"));
+}
+
+#[test]
+fn people_must_match_the_motion() {
+    let mut s = session();
+    say(&mut s, "people a \"a person\", b \"another\"");
+    let out = fails(&mut s, ":eval a.head.y");
+    assert!(out.contains("2 person(s)") && out.contains("has 1"), "{out}");
+}
+
+#[test]
+fn commands_report_usage() {
+    let mut s = session();
+    assert!(fails(&mut s, ":nope").contains(":help"));
+    assert!(say(&mut s, ":help").contains(":grad STATEMENT"));
+    assert!(say(&mut s, ":help eval").contains(":eval EXPR"));
+    assert!(s.handle(":quit").quit);
+}
