@@ -18,6 +18,7 @@ pub mod dataset;
 pub mod features;
 pub mod formats;
 pub mod fsutil;
+pub mod interrupt;
 pub mod lang;
 pub mod model;
 pub mod motion;

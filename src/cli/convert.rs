@@ -37,6 +37,8 @@ pub fn convert(args: ConvertArgs) -> Result<()> {
 /// Runs `mprog render`.
 pub fn render(args: RenderArgs) -> Result<()> {
     let (people, meta) = load_people(&args.input)?;
-    let title = args.title.unwrap_or_else(|| args.input.display().to_string());
+    let title = args
+        .title
+        .unwrap_or_else(|| args.input.display().to_string());
     write_outputs(&args.out, &people, &meta, &title)
 }

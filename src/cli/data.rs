@@ -93,7 +93,9 @@ fn show(args: ShowArgs) -> Result<()> {
         .clips
         .iter()
         .find(|c| c.name == args.clip)
-        .ok_or_else(|| miette::miette!("no clip named `{}` in {}", args.clip, args.data.display()))?;
+        .ok_or_else(|| {
+            miette::miette!("no clip named `{}` in {}", args.clip, args.data.display())
+        })?;
     let motion = mprog::motion::Motion::from_flat(data.clip_joints(clip));
     let title = format!("{} ({:?}): {}", clip.name, clip.split, clip.captions[0]);
     super::io::write_outputs(&args.out, &[motion], &Default::default(), &title)

@@ -1,14 +1,15 @@
 //! `mprog gen`: text-to-motion with the shipped model, no program.
 
-use super::io::{numbered, write_outputs};
+use super::io::{check_outputs, numbered, write_outputs};
+use burn::prelude::*;
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr};
 use mprog::formats::Meta;
+use mprog::interrupt::Interrupt;
 use mprog::model::ModelBundle;
-use mprog::model::generate::{GenerateRequest, generate};
+use mprog::model::generate::{GenerateError, GenerateRequest, generate_interruptible};
 use mprog::model::sampler::SamplerKind;
 use mprog::model::weights::default_model_dir;
-use burn::prelude::*;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -52,19 +53,25 @@ pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
     match name {
         "ddim" => Ok(SamplerKind::Ddim(steps.unwrap_or(50))),
         "ddpm" => Ok(SamplerKind::Ddpm(steps.unwrap_or(1000))),
-        other => Err(miette::miette!(help = "use ddim or ddpm", "unknown sampler `{other}`")),
+        other => Err(miette::miette!(
+            help = "use ddim or ddpm",
+            "unknown sampler `{other}`"
+        )),
     }
 }
 
 /// Runs `mprog gen`.
 pub fn run(args: GenArgs) -> Result<()> {
     let started = Instant::now();
+    check_outputs(&args.out, 1)?;
     let device = Device::flex();
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
-    let frames = args.frames.unwrap_or((args.seconds * 20.0).round() as usize);
+    let frames = args
+        .frames
+        .unwrap_or((args.seconds * 20.0).round() as usize);
     let sampler = sampler_kind(&args.sampler, args.steps)?;
     let req = GenerateRequest {
         prompts: vec![args.text.clone(); args.count.max(1)],
@@ -74,27 +81,58 @@ pub fn run(args: GenArgs) -> Result<()> {
         guidance_scale: args.guidance,
     };
     let bar = ProgressBar::new(0);
-    bar.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} denoising steps [{elapsed}]").expect("template"));
-    let out = generate(&bundle, &req, &device, |done, total| {
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} denoising steps [{elapsed}]")
+            .expect("template"),
+    );
+    // Ctrl-C stops between denoising steps; nothing is written then.
+    let interrupt = Interrupt::on_signals()
+        .into_diagnostic()
+        .wrap_err("cannot install the Ctrl-C handler")?;
+    let progress = |done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
-    })
-    .into_diagnostic()?;
+    };
+    let out = match generate_interruptible(&bundle, &req, &device, progress, &interrupt) {
+        Err(e @ GenerateError::Interrupted { .. }) => {
+            bar.finish_and_clear();
+            eprintln!("{e}");
+            std::process::exit(130);
+        }
+        other => other.into_diagnostic()?,
+    };
     bar.finish_and_clear();
     if let Some(unknown) = out.unknown_words.first().filter(|u| !u.is_empty()) {
-        eprintln!("ignored words the model does not know: {}", unknown.join(", "));
+        eprintln!(
+            "ignored words the model does not know: {}",
+            unknown.join(", ")
+        );
     }
     let mut meta = Meta::new();
     meta.insert("text".into(), args.text.clone().into());
     meta.insert("seed".into(), args.seed.into());
     meta.insert("sampler".into(), format!("{sampler:?}").into());
     meta.insert("guidance_scale".into(), (args.guidance as f64).into());
-    meta.insert("weights_id".into(), bundle.manifest.weights_id.clone().into());
+    meta.insert(
+        "weights_id".into(),
+        bundle.manifest.weights_id.clone().into(),
+    );
     let count = out.motions.len();
     for (i, motion) in out.motions.iter().enumerate() {
+        if interrupt.is_requested() {
+            eprintln!(
+                "interrupted: {i} of {count} motion(s) written, each complete; the rest were not written"
+            );
+            std::process::exit(130);
+        }
         let mut m = meta.clone();
         m.insert("sample".into(), i.into());
-        write_outputs(&numbered(&args.out, i, count), std::slice::from_ref(motion), &m, &args.text)?;
+        write_outputs(
+            &numbered(&args.out, i, count),
+            std::slice::from_ref(motion),
+            &m,
+            &args.text,
+        )?;
     }
     eprintln!(
         "generated {count} motion(s) of {frames} frames in {:.1} s (weights {})",

@@ -181,7 +181,11 @@ mod tests {
         let v = Vocabulary::from_captions(["walk run jump"], 8);
         let enc = BagOfWords::new(v.len(), 4, &dev);
         let batch = TokenBatch::new(&v, &["walk", "walk zzz"], &dev);
-        let e = enc.encode(&batch).into_data().try_into_vec::<f32>().unwrap();
+        let e = enc
+            .encode(&batch)
+            .into_data()
+            .try_into_vec::<f32>()
+            .unwrap();
         assert_eq!(e[..4], e[4..]);
         assert_eq!(batch.unknown[1], vec!["zzz".to_string()]);
     }
