@@ -301,11 +301,10 @@ fn json_centimetres_and_other_rates_are_converted() {
 fn dispatch_refuses_unknown_extensions_and_bvh_output() {
     let dir = tempfile::tempdir().unwrap();
     let m = [sample_motion(2, 0.0)];
-    let e = write_motion(&dir.path().join("x.bvh"), &m, &Meta::new()).unwrap_err();
-    assert!(
-        e.to_string().contains("BVH export is not implemented yet"),
-        "{e}"
-    );
+    // BVH holds one skeleton: two people are refused, nothing is written.
+    let two = [sample_motion(2, 0.0), sample_motion(2, 1.0)];
+    let e = write_motion(&dir.path().join("x.bvh"), &two, &Meta::new()).unwrap_err();
+    assert!(e.to_string().contains("one skeleton"), "{e}");
     let e = write_motion(&dir.path().join("x.csv"), &m, &Meta::new()).unwrap_err();
     assert!(e.to_string().contains("cannot write `.csv`"), "{e}");
     let e = read_motion(&dir.path().join("x.fbx")).unwrap_err();
