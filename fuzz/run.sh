@@ -16,11 +16,11 @@ seed() { # target, files…
     shift
     mkdir -p "$dir"
     for f in "$@"; do
-        [ -f "$f" ] && cp "$f" "$dir/seed-$(basename "$f")"
+        if [ -f "$f" ]; then cp "$f" "$dir/seed-$(basename "$f")"; fi
     done
 }
 seed mprog_check "$root"/programs/*.mprog "$root"/stdlib/*.mprog "$root"/tests/diagnostics/*.mprog
-seed bvh "$root"/tests/fixtures/bandai_like.bvh "$root"/tests/fixtures/adversarial/*.bvh \
+seed bvh "$root"/tests/fixtures/bandai_like.bvh "$root"/tests/fixtures/adversarial/[a-z]*.bvh \
     "$root"/tests/fixtures/fuzz/bvh/*
 seed npy "$root"/tests/fixtures/humanml3d/Mean.npy "$root"/tests/fixtures/adversarial/*.npy \
     "$root"/tests/fixtures/fuzz/npy/*

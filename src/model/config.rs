@@ -130,7 +130,7 @@ impl ModelConfig {
         in_range("d_model", self.d_model, 1, MAX_SIZE)?;
         in_range("layers", self.layers, 1, 256)?;
         in_range("heads", self.heads, 1, self.d_model)?;
-        if self.d_model % self.heads != 0 {
+        if !self.d_model.is_multiple_of(self.heads) {
             return Err(format!(
                 "`d_model` ({}) must be a multiple of `heads` ({})",
                 self.d_model, self.heads

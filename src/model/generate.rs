@@ -126,7 +126,7 @@ pub fn generate_interruptible(
         },
         &|| interrupt.is_requested(),
     )
-    .ok_or_else(|| GenerateError::Interrupted { done, total })?;
+    .ok_or(GenerateError::Interrupted { done, total })?;
     let features = denormalize_host(bundle, x0);
     if features.iter().any(|v| !v.is_finite()) {
         return Err(GenerateError::NonFinite);
