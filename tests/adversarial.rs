@@ -588,6 +588,23 @@ fn npy_nan_value_names_its_index() {
 }
 
 #[test]
+fn npy_deeply_nested_header_does_not_overflow_the_stack() {
+    // The header is a Python literal: nest it as deep as a version-1 header allows.
+    let depth = 30_000;
+    let header = format!(
+        "{{'descr': '<f4', 'fortran_order': False, 'shape': {}1{}, }}",
+        "[".repeat(depth),
+        "]".repeat(depth)
+    );
+    let mut h = header.into_bytes();
+    h.push(b'\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((h.len() as u16).to_le_bytes());
+    bytes.extend(h);
+    assert_mentions(&npy_error(bytes), &["bad.npy", "not a valid .npy file"]);
+}
+
+#[test]
 fn npy_absurd_shape() {
     let m = npy_error(npy("<f4", &[1 << 40, 22, 3], &[]));
     assert_mentions(&m, &["bad.npy", "over the limit"]);
@@ -789,6 +806,37 @@ fn program_deep_parentheses_do_not_overflow_the_stack() {
         ")".repeat(depth)
     );
     program_error(&src, "", 2);
+}
+
+#[test]
+fn program_long_chains_do_not_overflow_the_stack() {
+    // Chains without brackets: postfix, member, keyword and binary-operator chains.
+    let n = 40_000;
+    let cases = [
+        format!("length 4s\nalways {{ head{} > 1 m }}\n", "@1s".repeat(n)),
+        format!("length 4s\nalways {{ head{} > 1 m }}\n", ".y".repeat(n)),
+        format!(
+            "length 4s\nalways {{ head.y > 1 m{} }}\n",
+            " and head.y > 1 m".repeat(n / 8)
+        ),
+        format!("length 4s\nalways {{ 1 m{} }}\n", " < head.y".repeat(n / 4)),
+        format!("length 4s\nalways {{ head.y > 1 m{} }}\n", " * 1".repeat(n)),
+        format!("length 4s\nalways {{ head.y > {}1 m }}\n", "-".repeat(n)),
+        format!(
+            "length 4s\n{}always {{ head.y > 1 m }}\n",
+            "weight 2 ".repeat(n / 4)
+        ),
+        format!("length 4s\n{}head.y > 1 m\n", "at 1s ".repeat(n / 4)),
+    ];
+    for (i, src) in cases.into_iter().enumerate() {
+        let diags = no_panic(&format!("chain {i}"), move || {
+            check_source(&src, "chain.mprog", &[])
+        });
+        // Whatever the verdict, an error must point into the program.
+        for d in diags.to_json() {
+            assert!(d.line >= 1 && d.line <= 3, "chain {i}: {}", d.message);
+        }
+    }
 }
 
 #[test]
