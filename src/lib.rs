@@ -22,6 +22,7 @@ pub mod docgen;
 pub mod features;
 pub mod formats;
 pub mod fsutil;
+pub mod interrupt;
 pub mod lang;
 pub mod model;
 pub mod motion;

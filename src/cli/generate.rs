@@ -1,12 +1,13 @@
 //! `mprog gen`: text-to-motion with the shipped model, no program.
 
-use super::io::{numbered, write_outputs};
+use super::io::{check_outputs, numbered, write_outputs};
 use burn::prelude::*;
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr};
 use mprog::formats::Meta;
+use mprog::interrupt::Interrupt;
 use mprog::model::ModelBundle;
-use mprog::model::generate::{GenerateRequest, generate};
+use mprog::model::generate::{GenerateError, GenerateRequest, generate_interruptible};
 use mprog::model::sampler::SamplerKind;
 use mprog::model::weights::default_model_dir;
 use std::path::PathBuf;
@@ -62,6 +63,7 @@ pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
 /// Runs `mprog gen`.
 pub fn run(args: GenArgs) -> Result<()> {
     let started = Instant::now();
+    check_outputs(&args.out, 1)?;
     let device = Device::flex();
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let bundle = ModelBundle::load(&dir, &device)
@@ -83,11 +85,22 @@ pub fn run(args: GenArgs) -> Result<()> {
         ProgressStyle::with_template("{bar:30} {pos}/{len} denoising steps [{elapsed}]")
             .expect("template"),
     );
-    let out = generate(&bundle, &req, &device, |done, total| {
+    // Ctrl-C stops between denoising steps; nothing is written then.
+    let interrupt = Interrupt::on_signals()
+        .into_diagnostic()
+        .wrap_err("cannot install the Ctrl-C handler")?;
+    let progress = |done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
-    })
-    .into_diagnostic()?;
+    };
+    let out = match generate_interruptible(&bundle, &req, &device, progress, &interrupt) {
+        Err(e @ GenerateError::Interrupted { .. }) => {
+            bar.finish_and_clear();
+            eprintln!("{e}");
+            std::process::exit(130);
+        }
+        other => other.into_diagnostic()?,
+    };
     bar.finish_and_clear();
     if let Some(unknown) = out.unknown_words.first().filter(|u| !u.is_empty()) {
         eprintln!(
@@ -106,6 +119,12 @@ pub fn run(args: GenArgs) -> Result<()> {
     );
     let count = out.motions.len();
     for (i, motion) in out.motions.iter().enumerate() {
+        if interrupt.is_requested() {
+            eprintln!(
+                "interrupted: {i} of {count} motion(s) written, each complete; the rest were not written"
+            );
+            std::process::exit(130);
+        }
         let mut m = meta.clone();
         m.insert("sample".into(), i.into());
         write_outputs(

@@ -29,34 +29,53 @@ pub fn load_people(path: &Path) -> Result<(Vec<Motion>, Meta)> {
     })
 }
 
-/// Writes every requested output; pictures get `title`.
+/// Writes every requested output; pictures get `title`. Every output is checked before
+/// the first is written, so a bad one leaves none behind.
 pub fn write_outputs(
     outputs: &[PathBuf],
     people: &[Motion],
     meta: &Meta,
     title: &str,
 ) -> Result<()> {
+    check_outputs(outputs, people.len())?;
     for out in outputs {
-        let ext = out
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        match ext.as_str() {
+        match extension(out).as_str() {
             "gif" | "png" => render_to_path(people, &RenderOptions::titled(title), out)
                 .into_diagnostic()
                 .wrap_err_with(|| format!("rendering {}", out.display()))?,
-            "npy" | "json" | "bvh" => write_motion(out, people, meta).into_diagnostic()?,
-            _ => {
-                return Err(miette!(
-                    help = "use .bvh, .npy, .json, .gif or .png",
-                    "cannot write {}: unknown extension",
-                    out.display()
-                ));
-            }
+            _ => write_motion(out, people, meta).into_diagnostic()?,
         }
         eprintln!("wrote {}", out.display());
     }
     Ok(())
+}
+
+fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
+/// Whether every output can hold `people` motions, judged by its extension.
+pub fn check_outputs(outputs: &[PathBuf], people: usize) -> Result<()> {
+    outputs.iter().try_for_each(|out| check_output(out, people))
+}
+
+fn check_output(out: &Path, people: usize) -> Result<()> {
+    match extension(out).as_str() {
+        "gif" | "png" | "npy" | "json" => Ok(()),
+        "bvh" if people == 1 => Ok(()),
+        "bvh" => Err(miette!(
+            help = "write one .bvh per person, or use .json / .npy",
+            "cannot write {}: a BVH file holds one skeleton but there are {people} people",
+            out.display()
+        )),
+        _ => Err(miette!(
+            help = "use .bvh, .npy, .json, .gif or .png",
+            "cannot write {}: unknown extension",
+            out.display()
+        )),
+    }
 }
 
 /// Output paths with `_i` inserted before the extension, for sample `i` of `count`.

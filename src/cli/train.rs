@@ -3,6 +3,7 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::dataset::Dataset;
+use mprog::interrupt::Interrupt;
 use mprog::model::TrainConfig;
 use mprog::model::train::TrainRun;
 use std::io::IsTerminal;
@@ -31,13 +32,15 @@ pub struct TrainArgs {
 /// Runs `mprog train`.
 pub fn run(args: TrainArgs) -> Result<()> {
     let run_config = args.out.join("config.toml");
+    // Everything is read and checked before the run folder is created, so a bad
+    // argument leaves nothing behind.
     let config: TrainConfig = if args.resume {
         let text = std::fs::read_to_string(&run_config)
             .into_diagnostic()
             .wrap_err_with(|| format!("--resume needs {}", run_config.display()))?;
         toml::from_str(&text)
             .into_diagnostic()
-            .wrap_err("bad run config")?
+            .wrap_err_with(|| format!("bad run config {}", run_config.display()))?
     } else {
         if run_config.exists() {
             return Err(miette!(
@@ -49,18 +52,29 @@ pub fn run(args: TrainArgs) -> Result<()> {
         let text = std::fs::read_to_string(&args.config)
             .into_diagnostic()
             .wrap_err_with(|| format!("cannot read {}", args.config.display()))?;
-        let config: TrainConfig = toml::from_str(&text)
+        toml::from_str(&text)
             .into_diagnostic()
-            .wrap_err_with(|| format!("bad training config {}", args.config.display()))?;
+            .wrap_err_with(|| format!("bad training config {}", args.config.display()))?
+    };
+    let config_file = if args.resume {
+        &run_config
+    } else {
+        &args.config
+    };
+    config
+        .check()
+        .map_err(|e| miette!("bad training config {}: {e}", config_file.display()))?;
+    let data = Dataset::load(&args.data)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot load the training set {}", args.data.display()))?;
+    if !args.resume {
         std::fs::create_dir_all(&args.out).into_diagnostic()?;
         mprog::fsutil::write_bytes_atomic(
             &run_config,
             toml::to_string(&config).into_diagnostic()?.as_bytes(),
         )
         .into_diagnostic()?;
-        config
-    };
-    let data = Dataset::load(&args.data).into_diagnostic()?;
+    }
     eprintln!(
         "training on {} clips ({} train), d_model {}, {} layers, batch {}, crops of {} frames",
         data.index.clips.len(),
@@ -70,6 +84,9 @@ pub fn run(args: TrainArgs) -> Result<()> {
         config.batch_size,
         config.crop_frames
     );
+    let interrupt = Interrupt::on_signals()
+        .into_diagnostic()
+        .wrap_err("cannot install the Ctrl-C handler")?;
     let bar = ProgressBar::new(config.steps as u64);
     bar.set_style(
         ProgressStyle::with_template(
@@ -82,6 +99,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         config: config.clone(),
         out: args.out.clone(),
         max_steps_now: args.steps,
+        interrupt: interrupt.clone(),
     };
     let state = run
         .run(&|state, loss, lr| {
@@ -98,6 +116,14 @@ pub fn run(args: TrainArgs) -> Result<()> {
         })
         .into_diagnostic()?;
     bar.finish();
+    if interrupt.is_requested() {
+        eprintln!(
+            "interrupted at step {}: checkpoint saved in {}; continue with --resume",
+            state.step,
+            args.out.join("ckpt").display()
+        );
+        std::process::exit(130);
+    }
     eprintln!(
         "stopped at step {} after {:.0} s of training in total; last mean loss {:.4}, val {:?}",
         state.step, state.seconds, state.recent_loss, state.val_loss

@@ -187,12 +187,32 @@ impl Dataset {
         let (_, joints) = read_f32_npy(&dir.join("joints.npy"), &[NUM_JOINTS, 3])?;
         let (_, mean) = read_f32_npy(&dir.join("mean.npy"), &[])?;
         let (_, std) = read_f32_npy(&dir.join("std.npy"), &[])?;
-        let total: usize = index.clips.iter().map(|c| c.frames).sum();
+        let total = index
+            .clips
+            .iter()
+            .try_fold(0usize, |acc, c| acc.checked_add(c.frames))
+            .ok_or_else(|| invalid(&index_path, "clip frame counts overflow"))?;
         if features.len() != total * FEATURE_DIM || joints.len() != total * NUM_JOINTS * 3 {
             return Err(invalid(
                 dir,
                 format!("index lists {total} frames but the arrays disagree"),
             ));
+        }
+        for (i, c) in index.clips.iter().enumerate() {
+            let end = c.offset.checked_add(c.frames);
+            if c.frames == 0 || end.is_none_or(|e| e > total) || c.captions.is_empty() {
+                return Err(invalid(
+                    &index_path,
+                    format!(
+                        "clip {i} (`{}`) has offset {} and {} frames with {} captions; \
+                         clips need frames, captions and must lie inside the {total} frames",
+                        c.name,
+                        c.offset,
+                        c.frames,
+                        c.captions.len()
+                    ),
+                ));
+            }
         }
         if mean.len() != FEATURE_DIM || std.len() != FEATURE_DIM || std.iter().any(|s| *s <= 0.0) {
             return Err(invalid(

@@ -23,6 +23,9 @@ pub const FORMAT_VERSION: u32 = 1;
 /// Value of the `skeleton` field.
 pub const SKELETON_NAME: &str = "humanml3d-22";
 
+/// Longest motion a document may hold, in seconds (6 hours).
+pub const MAX_SECONDS: f64 = 6.0 * 3600.0;
+
 /// Free-form reproduction metadata.
 pub type Meta = serde_json::Map<String, serde_json::Value>;
 
@@ -176,6 +179,14 @@ impl PersonTrack {
         let who = format!("person {index} (\"{}\")", self.name);
         if self.frames.is_empty() {
             return Err(format!("{who} has no frames"));
+        }
+        // Reading resamples to 20 fps: a tiny `fps` would turn two frames into billions.
+        let seconds = (self.frames.len() - 1) as f64 / f64::from(fps);
+        if seconds > MAX_SECONDS {
+            return Err(format!(
+                "{who} is too long: {} frames at {fps} fps last {seconds:.3e} s; the limit is {MAX_SECONDS} s (check `fps`)",
+                self.frames.len()
+            ));
         }
         let mut frames = Vec::with_capacity(self.frames.len());
         for (f, joints) in self.frames.iter().enumerate() {

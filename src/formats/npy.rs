@@ -131,7 +131,7 @@ pub fn read_npy_bytes(origin: &str, bytes: &[u8]) -> Result<NpyArray, NpyError> 
         other => {
             return Err(NpyError::DType {
                 origin: origin.into(),
-                dtype: other.descr(),
+                dtype: other.descr().trim_matches('\'').to_string(),
             });
         }
     };

@@ -244,6 +244,11 @@ impl CostEstimate {
     pub fn work(&self, batch: usize) -> f64 {
         3.0 * self.elements_per_sample as f64 * batch as f64
     }
+
+    /// Tensor elements one forward pass produces for a batch of `batch` motions.
+    pub fn elements(&self, batch: usize) -> usize {
+        self.elements_per_sample.saturating_mul(batch)
+    }
 }
 
 impl Ir {
@@ -296,7 +301,12 @@ impl Ir {
 
     /// Estimated cost of one evaluation at the declared length.
     pub fn cost_estimate(&self) -> CostEstimate {
-        let f = self.length.max(1);
+        self.cost_estimate_at(self.length)
+    }
+
+    /// Estimated cost of one evaluation on motions of `frames` frames.
+    pub fn cost_estimate_at(&self, frames: usize) -> CostEstimate {
+        let f = frames.max(1);
         let mut domain_len = vec![None; self.domains.len()];
         let mut len_of = |d: DomainId| -> usize {
             *domain_len[d].get_or_insert_with(|| self.resolve_domain(d, f).len())
@@ -315,11 +325,14 @@ impl Ir {
                 _ => 1,
             };
             ops += per_op;
-            elements = elements.saturating_add(per_op * frames * node.lanes * node.channels);
+            let node_elements = (per_op * frames)
+                .saturating_mul(node.lanes)
+                .saturating_mul(node.channels);
+            elements = elements.saturating_add(node_elements);
         }
         for s in &self.statements {
             ops += if s.mask.is_some() { 6 } else { 3 };
-            elements = elements.saturating_add(len_of(s.domain) * s.lanes * 2);
+            elements = elements.saturating_add(len_of(s.domain).saturating_mul(s.lanes * 2));
         }
         CostEstimate {
             ops: ops + 2,

@@ -19,7 +19,7 @@ pub mod syntax;
 
 pub use check::{Header, ParamInfo, PersonInfo};
 pub use diag::{Diagnostic, Diagnostics, Severity};
-pub use eval::{EvalError, Evaluation, FrameErrors};
+pub use eval::{EvalError, Evaluation, FrameErrors, MAX_EVAL_ELEMENTS};
 pub use ir::CostEstimate;
 
 use burn::tensor::Tensor;
@@ -98,7 +98,8 @@ impl Program {
     /// Errors of a batch of motions `[batch, people, frames, 22, 3]` (metres, Y up).
     ///
     /// # Panics
-    /// If the tensor's shape does not fit the program; [`Program::try_evaluate`] reports it.
+    /// If the tensor's shape does not fit the program or the evaluation is estimated above
+    /// [`MAX_EVAL_ELEMENTS`]; [`Program::try_evaluate`] reports both.
     pub fn evaluate(&self, joints: Tensor<5>) -> Evaluation {
         match self.try_evaluate(joints) {
             Ok(e) => e,
@@ -106,8 +107,32 @@ impl Program {
         }
     }
 
-    /// Errors of a batch of motions, or why the tensor does not fit.
+    /// Errors of a batch of motions, or why the tensor does not fit, or a refusal when the
+    /// evaluation is estimated above [`MAX_EVAL_ELEMENTS`] tensor elements.
     pub fn try_evaluate(&self, joints: Tensor<5>) -> Result<Evaluation, EvalError> {
+        self.try_evaluate_with_limit(joints, MAX_EVAL_ELEMENTS)
+    }
+
+    /// [`Program::try_evaluate`] with another element limit. The cost is estimated for the
+    /// tensor's batch and frame count (not the declared length) before any tensor work.
+    pub fn try_evaluate_with_limit(
+        &self,
+        joints: Tensor<5>,
+        max_elements: usize,
+    ) -> Result<Evaluation, EvalError> {
+        let [batch, _, frames, _, _] = joints.dims();
+        let cost = self.checked.ir.cost_estimate_at(frames);
+        let elements = cost.elements(batch);
+        if elements > max_elements {
+            return Err(EvalError::TooCostly {
+                program: self.name.clone(),
+                batch,
+                frames,
+                ops: cost.ops,
+                elements,
+                limit: max_elements,
+            });
+        }
         eval::evaluate(&self.checked.ir, joints, &self.cache)
     }
 

@@ -100,3 +100,73 @@ impl Default for TrainConfig {
         }
     }
 }
+
+/// Largest accepted layer width, head count, layer count, … of a configuration: far above
+/// anything that trains on a CPU, low enough that a typo cannot ask for terabytes.
+const MAX_SIZE: usize = 1 << 16;
+
+fn in_range(name: &str, value: usize, lo: usize, hi: usize) -> Result<(), String> {
+    if (lo..=hi).contains(&value) {
+        Ok(())
+    } else {
+        Err(format!("`{name}` is {value}; it must be in {lo}..={hi}"))
+    }
+}
+
+fn fraction(name: &str, value: f64, hi_open: bool) -> Result<(), String> {
+    let ok = value.is_finite() && value >= 0.0 && if hi_open { value < 1.0 } else { value <= 1.0 };
+    if ok {
+        Ok(())
+    } else {
+        let hi = if hi_open { "1)" } else { "1]" };
+        Err(format!("`{name}` is {value}; it must be in [0, {hi}"))
+    }
+}
+
+impl ModelConfig {
+    /// Checks that the shape can be built; the message names the field.
+    pub fn check(&self) -> Result<(), String> {
+        in_range("features", self.features, 263, 263)?;
+        in_range("d_model", self.d_model, 1, MAX_SIZE)?;
+        in_range("layers", self.layers, 1, 256)?;
+        in_range("heads", self.heads, 1, self.d_model)?;
+        if !self.d_model.is_multiple_of(self.heads) {
+            return Err(format!(
+                "`d_model` ({}) must be a multiple of `heads` ({})",
+                self.d_model, self.heads
+            ));
+        }
+        in_range("d_ff", self.d_ff, 1, MAX_SIZE)?;
+        in_range("d_text", self.d_text, 1, MAX_SIZE)?;
+        in_range("max_frames", self.max_frames, 2, MAX_SIZE)?;
+        fraction("dropout", self.dropout, true)
+    }
+}
+
+impl TrainConfig {
+    /// Checks the settings (and the model shape); the message names the field.
+    pub fn check(&self) -> Result<(), String> {
+        self.model.check().map_err(|e| format!("[model] {e}"))?;
+        in_range("batch_size", self.batch_size, 1, MAX_SIZE)?;
+        in_range("crop_frames", self.crop_frames, 2, MAX_SIZE)?;
+        in_range("checkpoint_every", self.checkpoint_every, 1, usize::MAX)?;
+        for (name, v) in [
+            ("learning_rate", self.learning_rate),
+            ("grad_clip", self.grad_clip),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("`{name}` is {v}; it must be a positive number"));
+            }
+        }
+        for (name, v) in [
+            ("weight_decay", self.weight_decay),
+            ("foot_loss", self.foot_loss),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("`{name}` is {v}; it must be zero or positive"));
+            }
+        }
+        fraction("cond_drop", self.cond_drop, false)?;
+        fraction("ema_decay", self.ema_decay, true)
+    }
+}

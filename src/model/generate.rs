@@ -2,10 +2,11 @@
 //! de-normalised features → joints. Batched over `count` samples.
 
 use super::noise::NoiseSource;
-use super::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
+use super::sampler::{Condition, SamplerKind, sample_chain_until, schedule_for};
 use super::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use super::weights::ModelBundle;
 use crate::features::{FeatureError, recover_from_ric};
+use crate::interrupt::Interrupt;
 use crate::motion::Motion;
 use burn::prelude::*;
 
@@ -44,6 +45,14 @@ pub enum GenerateError {
     /// The model produced unusable numbers.
     #[error("the model produced non-finite features (NaN/Inf); the weights may be corrupt")]
     NonFinite,
+    /// An [`Interrupt`] stopped the sampler; nothing was produced.
+    #[error("interrupted after {done} of {total} denoising steps; nothing was generated")]
+    Interrupted {
+        /// Steps finished.
+        done: usize,
+        /// Steps of the whole chain.
+        total: usize,
+    },
     /// Recovering joints failed.
     #[error(transparent)]
     Features(#[from] FeatureError),
@@ -73,6 +82,18 @@ pub fn generate(
     device: &Device,
     on_step: impl FnMut(usize, usize),
 ) -> Result<Generated, GenerateError> {
+    generate_interruptible(bundle, req, device, on_step, &Interrupt::new())
+}
+
+/// [`generate`] that reads `interrupt` before every denoising step and stops with
+/// [`GenerateError::Interrupted`] once it is set.
+pub fn generate_interruptible(
+    bundle: &ModelBundle,
+    req: &GenerateRequest,
+    device: &Device,
+    mut on_step: impl FnMut(usize, usize),
+    interrupt: &Interrupt,
+) -> Result<Generated, GenerateError> {
     if req.prompts.is_empty() {
         return Err(GenerateError::Invalid("no prompt to generate from".into()));
     }
@@ -90,15 +111,22 @@ pub fn generate(
     let schedule = schedule_for(&NoiseSchedule::cosine(DIFFUSION_STEPS), req.sampler);
     let x_t = initial_noise(req, bundle.config.features, device);
     let mut noise = NoiseSource::new(req.seed ^ 0x5DEE_CE66);
-    let x0 = sample_chain(
+    let total = schedule.len();
+    let mut done = 0;
+    let x0 = sample_chain_until(
         &model,
         &schedule,
         req.sampler,
         x_t,
         &cond,
         &mut noise,
-        on_step,
-    );
+        |d, t| {
+            done = d;
+            on_step(d, t);
+        },
+        &|| interrupt.is_requested(),
+    )
+    .ok_or(GenerateError::Interrupted { done, total })?;
     let features = denormalize_host(bundle, x0);
     if features.iter().any(|v| !v.is_finite()) {
         return Err(GenerateError::NonFinite);

@@ -101,15 +101,36 @@ pub fn sample_chain(
     den: &impl Denoiser,
     schedule: &NoiseSchedule,
     kind: SamplerKind,
+    x_t: Tensor<3>,
+    cond: &Condition,
+    noise: &mut NoiseSource,
+    on_step: impl FnMut(usize, usize),
+) -> Tensor<3> {
+    let never = || false;
+    sample_chain_until(den, schedule, kind, x_t, cond, noise, on_step, &never)
+        .expect("never stopped")
+}
+
+/// [`sample_chain`] that asks `stop()` before each step and returns `None` when it says
+/// so (an interrupted run: nothing is sampled to the end).
+#[allow(clippy::too_many_arguments)]
+pub fn sample_chain_until(
+    den: &impl Denoiser,
+    schedule: &NoiseSchedule,
+    kind: SamplerKind,
     mut x_t: Tensor<3>,
     cond: &Condition,
     noise: &mut NoiseSource,
     mut on_step: impl FnMut(usize, usize),
-) -> Tensor<3> {
+    stop: &dyn Fn() -> bool,
+) -> Option<Tensor<3>> {
     let device = x_t.device();
     let dims = x_t.dims();
     let n = schedule.len();
     for i in (0..n).rev() {
+        if stop() {
+            return None;
+        }
         let x0 = guided_x0(den, x_t.clone(), schedule.timesteps[i], cond);
         x_t = match kind {
             SamplerKind::Ddim(_) => ddim_step(schedule, i, x_t, x0),
@@ -125,7 +146,7 @@ pub fn sample_chain(
         };
         on_step(n - i, n);
     }
-    x_t
+    Some(x_t)
 }
 
 /// The schedule a sampler kind runs on.

@@ -101,7 +101,7 @@ fn ddim_is_deterministic_from_the_seed() {
             |_, _| {},
         )
         .into_data()
-        .try_to_vec::<f32>()
+        .try_into_vec::<f32>()
         .unwrap()
     };
     assert_eq!(run(1), run(1));
@@ -169,6 +169,7 @@ fn training_learns_and_resumes_from_checkpoints() {
         config: config.clone(),
         out: dir.path().to_path_buf(),
         max_steps_now: Some(steps),
+        interrupt: Default::default(),
     };
     let first = run(30).run(&|_, _, _| {}).unwrap();
     assert_eq!(first.step, 30);
@@ -190,4 +191,56 @@ fn training_learns_and_resumes_from_checkpoints() {
     let bundle =
         super::weights::ModelBundle::load(&dir.path().join("bundle"), &Device::flex()).unwrap();
     assert_eq!(bundle.manifest.steps, 60);
+}
+
+#[test]
+fn interrupted_training_saves_a_checkpoint_and_resumes() {
+    let data = synthetic_dataset();
+    let dir = tempfile::tempdir().unwrap();
+    let config = TrainConfig {
+        model: tiny(),
+        batch_size: 2,
+        crop_frames: 8,
+        warmup_steps: 1,
+        checkpoint_every: 10,
+        steps: 12,
+        ..TrainConfig::default()
+    };
+    let interrupt = crate::interrupt::Interrupt::new();
+    let run = TrainRun {
+        data: &data,
+        config: config.clone(),
+        out: dir.path().to_path_buf(),
+        max_steps_now: None,
+        interrupt: interrupt.clone(),
+    };
+    // Ctrl-C arrives during step 4, between checkpoints (every 10 steps).
+    let stopped = run
+        .run(&|state, _, _| {
+            if state.step == 4 {
+                interrupt.request();
+            }
+        })
+        .unwrap();
+    assert_eq!(stopped.step, 4, "the run stops after the step in progress");
+    let state = std::fs::read_to_string(dir.path().join("ckpt/state.json")).unwrap();
+    assert!(
+        state.contains("\"step\": 4"),
+        "checkpoint of step 4: {state}"
+    );
+    let csv = std::fs::read_to_string(dir.path().join("loss.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        1 + 4,
+        "every finished step is logged once"
+    );
+    let resumed = TrainRun {
+        interrupt: Default::default(),
+        ..run
+    }
+    .run(&|_, _, _| {})
+    .unwrap();
+    assert_eq!(resumed.step, 12);
+    let csv = std::fs::read_to_string(dir.path().join("loss.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 12);
 }

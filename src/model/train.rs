@@ -28,6 +28,7 @@ use super::weights::{
 };
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
 use crate::fsutil::write_bytes_atomic;
+use crate::interrupt::Interrupt;
 use burn::module::Module;
 use burn::optim::{
     AdamWConfig, GradientsParams, ModuleOptimizer, grad_clipping::GradientClippingConfig,
@@ -166,6 +167,8 @@ pub struct TrainRun<'a> {
     pub out: PathBuf,
     /// Stop after this many steps in this session (None = until `config.steps`).
     pub max_steps_now: Option<usize>,
+    /// Read between steps: when set, the run saves a checkpoint and returns.
+    pub interrupt: Interrupt,
 }
 
 struct Checkpoint {
@@ -366,6 +369,8 @@ impl TrainRun<'_> {
     /// last checkpoint in `out` if there is one.
     pub fn run(&self, progress: &dyn Fn(&TrainState, f32, f64)) -> Result<TrainState, TrainError> {
         let cfg = &self.config;
+        cfg.check()
+            .map_err(|e| TrainError::Invalid(format!("training config: {e}")))?;
         let train: Vec<&ClipInfo> = self.data.clips(Split::Train).collect();
         if train.is_empty() {
             return Err(TrainError::Invalid(
@@ -381,11 +386,14 @@ impl TrainRun<'_> {
             Some(n) => (ck.state.step + n).min(cfg.steps),
             None => cfg.steps,
         };
-        let loss_path = self.out.join("loss.csv");
         let mut pending = String::new();
         let mut since_ckpt = (0.0f64, 0usize);
         let mut clock = Instant::now();
+        let mut saved_at = ck.state.step;
         while ck.state.step < stop_at {
+            if self.interrupt.is_requested() {
+                break;
+            }
             let step = ck.state.step;
             let batch = draw_batch(self.data, &train, cfg, step);
             let loss = batch_loss(&ck.model, &schedule, &batch, &vocab, &device);
@@ -409,23 +417,59 @@ impl TrainRun<'_> {
             ));
             progress(&ck.state, value, lr);
             if ck.state.step % cfg.checkpoint_every == 0 || ck.state.step == stop_at {
-                ck.state.recent_loss = since_ckpt.0 / since_ckpt.1.max(1) as f64;
-                since_ckpt = (0.0, 0);
-                ck.state.val_loss = self.validate(&ck.ema, &vocab, &schedule, &plain);
-                append(&loss_path, "step,loss,lr,seconds\n", &pending)?;
-                pending.clear();
-                if let Some(v) = ck.state.val_loss {
-                    append(
-                        &self.out.join("val.csv"),
-                        "step,val_loss,seconds\n",
-                        &format!("{},{v},{:.1}\n", ck.state.step, ck.state.seconds),
-                    )?;
-                }
-                self.save(&ck, &vocab)?;
+                self.checkpoint(
+                    &mut ck,
+                    &mut since_ckpt,
+                    &mut pending,
+                    &vocab,
+                    &schedule,
+                    &plain,
+                )?;
+                saved_at = ck.state.step;
                 clock = Instant::now();
             }
         }
+        if ck.state.step > saved_at {
+            // Interrupted between checkpoints: keep every finished step.
+            self.checkpoint(
+                &mut ck,
+                &mut since_ckpt,
+                &mut pending,
+                &vocab,
+                &schedule,
+                &plain,
+            )?;
+        }
         Ok(ck.state)
+    }
+
+    /// Validates, appends the loss rows and saves the checkpoint.
+    fn checkpoint(
+        &self,
+        ck: &mut Checkpoint,
+        since_ckpt: &mut (f64, usize),
+        pending: &mut String,
+        vocab: &Vocabulary,
+        schedule: &NoiseSchedule,
+        plain: &Device,
+    ) -> Result<(), TrainError> {
+        ck.state.recent_loss = since_ckpt.0 / since_ckpt.1.max(1) as f64;
+        *since_ckpt = (0.0, 0);
+        ck.state.val_loss = self.validate(&ck.ema, vocab, schedule, plain);
+        append(
+            &self.out.join("loss.csv"),
+            "step,loss,lr,seconds\n",
+            pending,
+        )?;
+        pending.clear();
+        if let Some(v) = ck.state.val_loss {
+            append(
+                &self.out.join("val.csv"),
+                "step,val_loss,seconds\n",
+                &format!("{},{v},{:.1}\n", ck.state.step, ck.state.seconds),
+            )?;
+        }
+        self.save(ck, vocab)
     }
 }
 

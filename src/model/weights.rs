@@ -169,6 +169,9 @@ impl ModelBundle {
         let config_path = dir.join("config.toml");
         let config: ModelConfig = toml::from_str(&read_text(&config_path)?)
             .map_err(|e| mismatch(&config_path, format!("bad model config: {e}")))?;
+        config
+            .check()
+            .map_err(|e| mismatch(&config_path, format!("bad model config: {e}")))?;
         let vocab_path = dir.join("vocab.json");
         let vocab: Vocabulary = serde_json::from_str(&read_text(&vocab_path)?)
             .map_err(|e| mismatch(&vocab_path, format!("bad vocabulary: {e}")))?;

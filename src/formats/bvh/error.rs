@@ -69,6 +69,8 @@ pub enum BvhErrorKind {
     UnknownChannel(String),
     #[error("the file ends inside the hierarchy: joint `{0}` is never closed with `}}`")]
     UnclosedJoint(String),
+    #[error("joints are nested more than {0} levels deep")]
+    TooDeep(usize),
     #[error("no joints: the HIERARCHY section has no ROOT")]
     NoJoints,
     #[error("no joint has channels: a BVH file needs at least one CHANNELS entry")]

@@ -36,8 +36,7 @@ pub fn sample_points(frame_count: usize, source_fps: f32, fps: f32) -> Vec<Sampl
             .collect();
     }
     let ratio = f64::from(source_fps) / f64::from(fps);
-    // The epsilon keeps an exact end frame that f64 rounding would put just short of it.
-    let count = (((frame_count - 1) as f64 / ratio) + 1e-9).floor() as usize + 1;
+    let count = sample_count(frame_count, source_fps, fps) as usize;
     (0..count)
         .map(|k| {
             let src = k as f64 * ratio;
@@ -50,6 +49,17 @@ pub fn sample_points(frame_count: usize, source_fps: f32, fps: f32) -> Vec<Sampl
             }
         })
         .collect()
+}
+
+/// Number of output frames [`sample_points`] makes (as `f64`, so absurd frame rates can be
+/// refused before anything is allocated).
+pub fn sample_count(frame_count: usize, source_fps: f32, fps: f32) -> f64 {
+    if frame_count < 2 || (fps - source_fps).abs() < 1e-6 {
+        return frame_count as f64;
+    }
+    let ratio = f64::from(source_fps) / f64::from(fps);
+    // The epsilon keeps an exact end frame that f64 rounding would put just short of it.
+    (((frame_count - 1) as f64 / ratio) + 1e-9).floor() + 1.0
 }
 
 /// Global positions of every joint at every source frame, frame-major:

@@ -9,6 +9,9 @@ use super::parse::{BvhJoint, Channel};
 use super::text::{Token, parse_number, tokenize};
 use glam::Vec3;
 
+/// Deepest accepted joint nesting (real rigs stay under 30; the parser recurses per level).
+pub const MAX_JOINT_DEPTH: usize = 256;
+
 /// Parses the hierarchy lines (`lines[0]` is line 1 of the file).
 pub fn parse_hierarchy(origin: &str, lines: &[&str]) -> Result<Vec<BvhJoint>, BvhError> {
     let tokens = tokenize(lines.iter().enumerate().map(|(i, l)| (i + 1, *l)));
@@ -18,6 +21,7 @@ pub fn parse_hierarchy(origin: &str, lines: &[&str]) -> Result<Vec<BvhJoint>, Bv
         pos: 0,
         joints: Vec::new(),
         channels: 0,
+        depth: 0,
     };
     parser.document()?;
     Ok(parser.joints)
@@ -30,6 +34,8 @@ struct Parser<'t, 'a> {
     joints: Vec<BvhJoint>,
     /// Channels declared so far (the next joint's first channel index).
     channels: usize,
+    /// Joints open around the current one.
+    depth: usize,
 }
 
 impl<'a> Parser<'_, 'a> {
@@ -89,7 +95,14 @@ impl<'a> Parser<'_, 'a> {
                     self.joints[index].channels = channels;
                     has_channels = true;
                 }
-                "JOINT" => self.joint(t, Some(index))?,
+                "JOINT" => {
+                    if self.depth >= MAX_JOINT_DEPTH {
+                        return Err(self.err(t.line, BvhErrorKind::TooDeep(MAX_JOINT_DEPTH)));
+                    }
+                    self.depth += 1;
+                    self.joint(t, Some(index))?;
+                    self.depth -= 1;
+                }
                 "END" => self.end_site(t, index)?,
                 "}" => break,
                 _ => return Err(self.err(t.line, BvhErrorKind::UnknownKeyword(t.text.into()))),

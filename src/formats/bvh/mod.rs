@@ -129,6 +129,17 @@ pub fn import_bvh_str(
     let bvh = parse_bvh(origin, text, opts.limits)?;
     let joint_map = retarget::map_joints(&bvh).map_err(|kind| BvhError::whole(origin, kind))?;
     let source_fps = bvh.fps();
+    // A long frame time makes many output frames from few lines: bound what FK allocates.
+    let out_values =
+        fk::sample_count(bvh.frame_count, source_fps, opts.fps) * (bvh.joints.len() * 3) as f64;
+    if out_values > opts.limits.max_values as f64 {
+        let kind = BvhErrorKind::TooBig {
+            what: "frames after resampling × joints × 3",
+            count: out_values.min(u64::MAX as f64) as u64,
+            limit: opts.limits.max_values,
+        };
+        return Err(BvhError::whole(origin, kind));
+    }
     // Resampled on the channels, so bones stay rigid (see `fk`).
     let samples = fk::sample_points(bvh.frame_count, source_fps, opts.fps);
     let globals = fk::global_positions_at(&bvh, &samples);

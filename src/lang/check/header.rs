@@ -309,12 +309,12 @@ impl<'a> Checker<'a> {
                     format!("`--set {n}=…` cannot replace a vector"),
                 )
                 .help("only scalar parameters can be set from the command line");
-            } else if !v.is_finite() {
+            } else if !v.is_finite() || !((v * scale) as f32).is_finite() {
                 self.error(
                     cx,
                     "mprog::bad_override",
                     name.span,
-                    format!("`--set {n}` needs a finite number"),
+                    format!("`--set {n}` needs a finite number (|x| ≤ 3.4e38), got {v}"),
                 )
                 .help("e.g. `--set diameter=0.5`");
             } else {

@@ -25,7 +25,7 @@ pub mod units;
 pub mod values;
 
 use crate::lang::diag::{Diagnostic, Severity};
-use crate::lang::ir::{CostEstimate, Ir, NodeId};
+use crate::lang::ir::{CostEstimate, Ir, NodeId, Op};
 use crate::lang::syntax::ast::{Expr, FnDef, Module, Span};
 use builder::Builder;
 use std::collections::HashMap;
@@ -238,6 +238,26 @@ pub fn module_to_ir<'a>(
         return (None, c.diags);
     }
     let ir = c.finish();
+    // Constants are folded in f64 and stored as f32: a literal like `1e39` or a product
+    // like `1e30 * 1e30` would evaluate to ∞ or NaN.
+    for node in &ir.nodes {
+        if let Op::Const(v) = &node.op
+            && let Some(x) = v.iter().find(|x| !x.is_finite())
+        {
+            c.diags.push(
+                Diagnostic::error(
+                    "mprog::number_out_of_range",
+                    node.span,
+                    format!("this value is {x} in 32-bit floats (|x| ≤ 3.4e38)"),
+                )
+                .label("not a finite number")
+                .help("use a smaller number; lengths are in metres, times in seconds"),
+            );
+        }
+    }
+    if c.diags.iter().any(|d| d.severity == Severity::Error) {
+        return (None, c.diags);
+    }
     let cost = ir.cost_estimate();
     if cost.ops > MAX_OPS || cost.elements_per_sample > MAX_ELEMENTS_PER_SAMPLE {
         c.diags.push(

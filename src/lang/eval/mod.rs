@@ -37,7 +37,33 @@ pub enum EvalError {
         /// People the program declares.
         people: usize,
     },
+    /// The evaluation is estimated above the element limit; nothing was computed.
+    #[error(
+        "{program}: evaluating on {batch} motion(s) of {frames} frames is estimated at \
+         {elements} tensor elements ({ops} ops per motion); the limit is {limit} elements"
+    )]
+    TooCostly {
+        /// The program's name.
+        program: String,
+        /// Motions in the batch.
+        batch: usize,
+        /// Frames per motion.
+        frames: usize,
+        /// Estimated tensor ops of one motion.
+        ops: usize,
+        /// Estimated tensor elements of the whole batch (forward pass).
+        elements: usize,
+        /// The limit it exceeds.
+        limit: usize,
+    },
 }
+
+/// Default limit on the estimated tensor elements of one evaluation (forward pass, whole
+/// batch): 2.7·10⁸ elements, about 1 GiB of `f32`. That is a batch of 13 motions at the
+/// checker's per-motion limit ([`crate::lang::check::MAX_ELEMENTS_PER_SAMPLE`] at the
+/// declared length) and thousands of motions of a typical program; longer motions or
+/// bigger batches than that are refused before any tensor work.
+pub const MAX_EVAL_ELEMENTS: usize = 1 << 28;
 
 /// Frame-index tensors for one frame count and device, reused across evaluations.
 #[derive(Default)]
