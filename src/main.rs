@@ -30,6 +30,8 @@ enum Command {
     Bench(cli::bench::BenchCommand),
     /// Train the denoiser on a dataset built by `mprog data build`.
     Train(cli::train::TrainArgs),
+    /// Run a program: generate with the model, steered by the program's error.
+    Run(cli::run::RunArgs),
     /// A program's error on a motion file, per statement, with an optional plot over time.
     Score(cli::score::ScoreArgs),
     /// Check `.mprog` programs and print their diagnostics.
@@ -57,6 +59,7 @@ fn main() -> miette::Result<()> {
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
         Command::Score(args) => cli::score::run(args)?,
+        Command::Run(args) => cli::run::run(args)?,
         Command::Repl(args) => cli::repl::run(args)?,
         Command::Prompt => print!("{}", mprog::docgen::prompt::system_prompt()),
         Command::Doc(cmd) => cli::doc::run(cmd)?,

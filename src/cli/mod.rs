@@ -11,3 +11,4 @@ pub mod score;
 pub mod train;
 pub mod repl;
 pub mod doc;
+pub mod run;

@@ -1,0 +1,182 @@
+//! `mprog run`: a program becomes a motion. Generate with the shipped model, steer it with
+//! the program's error through a solver, print each statement's error next to the
+//! unguided sample's, and write the outputs with everything needed to reproduce them.
+
+use super::io::{check_outputs, write_outputs};
+use super::score::compile_file;
+use burn::prelude::*;
+use indicatif::{ProgressBar, ProgressStyle};
+use miette::{IntoDiagnostic, Result, WrapErr, miette};
+use mprog::formats::Meta;
+use mprog::lang::Program;
+use mprog::model::ModelBundle;
+use mprog::model::weights::default_model_dir;
+use mprog::motion::Motion;
+use mprog::solve::{Prior, Progress, SolveRequest, SolveResult, Solver, solve};
+use std::path::PathBuf;
+
+/// Arguments of `mprog run`.
+#[derive(clap::Args)]
+pub struct RunArgs {
+    /// The program.
+    program: PathBuf,
+    /// Solver: guide (OmniControl), latent (PMG), ik, ik-reg, lbfgs (InterControl), plain.
+    #[arg(long, default_value = "guide")]
+    solver: String,
+    /// Seed: the same program, seed, settings and weights give the same motion.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Override a parameter: `--set diameter=0.5` (in the unit of its default).
+    #[arg(long = "set", value_parser = super::check::parse_override)]
+    set: Vec<(String, f64)>,
+    /// Prompt for a single-person program without a `prompt` line.
+    #[arg(long)]
+    text: Option<String>,
+    /// Skip the unguided comparison sample.
+    #[arg(long)]
+    no_baseline: bool,
+    /// Model bundle folder (default: models/default).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Outputs by extension: .bvh (one person) .npy .json .gif .png.
+    #[arg(short, long, num_args = 1.., required = true)]
+    out: Vec<PathBuf>,
+}
+
+fn prompts_of(program: &Program, text: &Option<String>) -> Result<Vec<String>> {
+    let prompts = program.prompts();
+    prompts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            p.clone().or_else(|| text.clone()).ok_or_else(|| {
+                miette!(
+                    help = "add `prompt \"…\"` to the program or pass --text",
+                    "person {} of {} has no prompt",
+                    i + 1,
+                    program.name()
+                )
+            })
+        })
+        .collect()
+}
+
+/// `[1, people, frames, 22, 3]` of one sample.
+fn sample_tensor(people: &[Motion], device: &Device) -> Tensor<5> {
+    super::score::people_tensor(people, device)
+}
+
+fn per_statement(program: &Program, people: &[Motion], device: &Device) -> Result<Vec<f32>> {
+    let e = program.try_evaluate(sample_tensor(people, device)).into_diagnostic()?;
+    e.per_statement
+        .into_data()
+        .try_into_vec::<f32>()
+        .map_err(|e| miette!("{e:?}"))
+}
+
+fn solve_with_bar(
+    bundle: &ModelBundle,
+    req: &SolveRequest,
+    program: &Program,
+    device: &Device,
+    label: &str,
+) -> Result<SolveResult> {
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template(&format!("{label:>9} {{bar:30}} {{pos}}/{{len}} {{msg}} [{{elapsed}}]"))
+            .expect("template"),
+    );
+    let error = |j: Tensor<5>| program.evaluate(j).total;
+    let out = solve(&Prior::from_bundle(bundle), req, &error, device, |p: Progress| {
+        bar.set_length(p.total as u64);
+        bar.set_position(p.done as u64);
+        if let Some(e) = p.error {
+            bar.set_message(format!("error {e:.4}"));
+        }
+    })
+    .into_diagnostic()
+    .wrap_err_with(|| format!("solver {}", req.solver.name()))?;
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+/// Runs `mprog run`.
+pub fn run(args: RunArgs) -> Result<()> {
+    let program = compile_file(&args.program, &args.set)?;
+    let solver = Solver::by_name(&args.solver).ok_or_else(|| {
+        miette!(
+            help = "use guide, latent, ik, ik-reg, lbfgs or plain",
+            "unknown solver `{}`",
+            args.solver
+        )
+    })?;
+    let prompts = prompts_of(&program, &args.text)?;
+    check_outputs(&args.out, prompts.len())?;
+    let device = Device::flex();
+    let dir = args.model.clone().unwrap_or_else(default_model_dir);
+    let bundle = ModelBundle::load(&dir, &device)
+        .into_diagnostic()
+        .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
+    let frames = program.length();
+    let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.clone());
+    let result = solve_with_bar(&bundle, &req, &program, &device, solver.name())?;
+    let people = &result.motions[0];
+    let guided = per_statement(&program, people, &device)?;
+    let baseline = if args.no_baseline {
+        None
+    } else {
+        let plain = match &solver {
+            Solver::Latent(_) | Solver::Ik(_) => Solver::by_name("plain").map(|_| {
+                Solver::Plain(mprog::model::sampler::SamplerKind::Ddim(100))
+            }),
+            _ => Solver::by_name("plain"),
+        }
+        .expect("plain exists");
+        let req = SolveRequest::new(prompts.clone(), frames, args.seed, plain);
+        let r = solve_with_bar(&bundle, &req, &program, &device, "unguided")?;
+        Some((per_statement(&program, &r.motions[0], &device)?, r.seconds))
+    };
+    println!("| line | statement | unit | unguided | {} |", solver.name());
+    println!("| --- | --- | --- | --- | --- |");
+    for (i, s) in program.statements().iter().enumerate() {
+        let text = s.label.split_once(": ").map_or(s.label.as_str(), |(_, t)| t).trim();
+        let base = baseline.as_ref().map_or("—".into(), |(b, _)| format!("{:.4}", b[i]));
+        println!("| {} | `{text}` | {} | {base} | {:.4} |", s.line, s.unit, guided[i]);
+    }
+    let total: f32 = guided.iter().sum();
+    let base_total = baseline.as_ref().map_or("—".into(), |(b, _)| format!("{:.4}", b.iter().sum::<f32>()));
+    println!("| | **total** | | {base_total} | {total:.4} |");
+    match &baseline {
+        Some((_, s)) => eprintln!("{}: {:.1} s (unguided: {s:.1} s)", solver.name(), result.seconds),
+        None => eprintln!("{}: {:.1} s", solver.name(), result.seconds),
+    }
+    let mut meta = Meta::new();
+    meta.insert("program".into(), std::fs::read_to_string(&args.program).unwrap_or_default().into());
+    meta.insert("program_file".into(), args.program.display().to_string().into());
+    meta.insert("overrides".into(), serde_json::json!(args.set));
+    meta.insert("seed".into(), args.seed.into());
+    meta.insert("solver".into(), format!("{solver:?}").into());
+    meta.insert("weights_id".into(), bundle.manifest.weights_id.clone().into());
+    meta.insert("prompts".into(), serde_json::json!(prompts));
+    meta.insert("statement_errors".into(), statement_errors(&program, people, &device)?);
+    write_outputs(&args.out, people, &meta, &format!("{} ({})", program.name(), solver.name()))
+}
+
+/// `[{label, line, unit, frames, values}]` for the viewer's timeline.
+fn statement_errors(program: &Program, people: &[Motion], device: &Device) -> Result<serde_json::Value> {
+    let frames = program.evaluate_frames(sample_tensor(people, device)).into_diagnostic()?;
+    let list: Vec<serde_json::Value> = program
+        .statements()
+        .iter()
+        .zip(frames)
+        .map(|(s, f)| {
+            let values: Vec<Option<f32>> = f.errors[0]
+                .iter()
+                .zip(&f.applies[0])
+                .map(|(v, a)| a.then_some(*v))
+                .collect();
+            serde_json::json!({"label": s.label, "line": s.line, "unit": s.unit, "frames": f.frames, "values": values})
+        })
+        .collect();
+    Ok(serde_json::Value::Array(list))
+}
