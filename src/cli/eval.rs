@@ -46,7 +46,7 @@ struct RunArgs {
     #[arg(long)]
     evaluator: Option<PathBuf>,
     /// Test captions to generate from.
-    #[arg(long, default_value_t = 48)]
+    #[arg(long, default_value_t = 32)]
     count: usize,
     /// Seed of the clip choice, captions and noise.
     #[arg(long, default_value_t = 1)]
@@ -67,7 +67,7 @@ struct RunArgs {
     #[arg(long)]
     per_label: bool,
     /// Motions generated per label for `--per-label`.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 3)]
     per_label_count: usize,
     /// Also write the tables to this markdown file.
     #[arg(long)]
@@ -116,15 +116,20 @@ fn train_encoder(args: TrainEncoderArgs) -> Result<()> {
     };
     let bar = ProgressBar::new(cfg.steps as u64);
     bar.set_style(
-        ProgressStyle::with_template("{bar:30} {pos}/{len} steps  {msg}  [{elapsed_precise}, eta {eta}]")
-            .expect("valid template"),
+        ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} steps  {msg}  [{elapsed_precise}, eta {eta}]",
+        )
+        .expect("valid template"),
     );
     let mut recent = Vec::new();
     let (evaluator, losses) = train_evaluator(&data, &cfg, &mut |step, loss| {
         recent.push(loss);
         let tail = &recent[recent.len().saturating_sub(20)..];
         bar.set_position(step as u64);
-        bar.set_message(format!("loss {:.3}", tail.iter().sum::<f32>() / tail.len() as f32));
+        bar.set_message(format!(
+            "loss {:.3}",
+            tail.iter().sum::<f32>() / tail.len() as f32
+        ));
     })
     .into_diagnostic()?;
     bar.finish();
@@ -143,9 +148,7 @@ fn train_encoder(args: TrainEncoderArgs) -> Result<()> {
 }
 
 fn evaluate(args: RunArgs) -> Result<()> {
-    let data_dir = args
-        .data
-        .ok_or_else(|| miette!("--data is required"))?;
+    let data_dir = args.data.ok_or_else(|| miette!("--data is required"))?;
     let device = burn::prelude::Device::flex();
     let data = Dataset::load(&data_dir).into_diagnostic()?;
     let model_dir = args.model.unwrap_or_else(default_model_dir);
@@ -173,9 +176,14 @@ fn evaluate(args: RunArgs) -> Result<()> {
         min_frames: args.min_frames,
         per_label: args.per_label.then_some(args.per_label_count),
     };
-    let (report, samples) = run_eval(&data, &bundle, &evaluator, &settings, &device, &mut |line| {
-        eprintln!("{line}")
-    })
+    let (report, samples) = run_eval(
+        &data,
+        &bundle,
+        &evaluator,
+        &settings,
+        &device,
+        &mut |line| eprintln!("{line}"),
+    )
     .into_diagnostic()?;
     let text = report_markdown(&report);
     println!("{text}");

@@ -109,9 +109,21 @@ pub fn net_from_safetensors(
         return Err(format!(
             "weights do not fit the configured evaluator: {} errors ({}), {} missing tensors ({})",
             result.errors.len(),
-            result.errors.iter().take(3).map(|e| format!("{e:?}")).collect::<Vec<_>>().join("; "),
+            result
+                .errors
+                .iter()
+                .take(3)
+                .map(|e| format!("{e:?}"))
+                .collect::<Vec<_>>()
+                .join("; "),
             result.missing.len(),
-            result.missing.iter().take(3).map(|m| format!("{m:?}")).collect::<Vec<_>>().join(", ")
+            result
+                .missing
+                .iter()
+                .take(3)
+                .map(|m| format!("{m:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
         ));
     }
     Ok(net)
@@ -204,7 +216,10 @@ impl Evaluator {
         let bytes = net_to_safetensors(&self.net, self.manifest.half_precision)
             .map_err(|e| file_error(&p, e))?;
         put("model.safetensors", &bytes)?;
-        put("README.md", super::card::model_card(&self.manifest).as_bytes())
+        put(
+            "README.md",
+            super::card::model_card(&self.manifest).as_bytes(),
+        )
     }
 
     /// Embeds motions given as de-normalised feature rows (`[frames, F]` each).

@@ -215,7 +215,11 @@ mod tests {
         );
         // A rank-deficient one: [[1,1],[1,1]] = 2·uuᵀ → √2·uuᵀ = [[1,1],[1,1]]/√2.
         let h = 0.5f64.sqrt();
-        close(&sqrt_psd(&[1.0, 1.0, 1.0, 1.0], 2).unwrap(), &[h, h, h, h], 1e-12);
+        close(
+            &sqrt_psd(&[1.0, 1.0, 1.0, 1.0], 2).unwrap(),
+            &[h, h, h, h],
+            1e-12,
+        );
     }
 
     #[test]

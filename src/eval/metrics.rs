@@ -14,6 +14,8 @@
 //! * [`mean_root_speed`]: mean horizontal pelvis speed (m/s).
 //! * [`total_turn`]: unwrapped heading change of the pelvis path (degrees, + = left turn).
 //! * [`wrists_above_head`]: max over frames of (highest wrist y − head y) (m).
+//! * [`right_minus_left_wrist`]: peak height of the right wrist minus that of the left (m),
+//!   telling which hand a one-handed gesture used.
 
 use crate::motion::Motion;
 use crate::skeleton::{NUM_JOINTS, PARENTS};
@@ -193,10 +195,7 @@ pub fn total_turn(m: &Motion) -> f32 {
             (d.length() > min_step).then(|| heading(d))
         })
         .collect();
-    let turn: f32 = headings
-        .windows(2)
-        .map(|h| wrap_angle(h[1] - h[0]))
-        .sum();
+    let turn: f32 = headings.windows(2).map(|h| wrap_angle(h[1] - h[0])).sum();
     turn.to_degrees()
 }
 
@@ -217,6 +216,19 @@ pub fn wrists_above_head(m: &Motion) -> f32 {
         .unwrap_or(0.0)
 }
 
+/// max over frames of the right wrist's height minus max over frames of the left wrist's
+/// (m): positive when the right hand went higher. 0 for an empty motion.
+pub fn right_minus_left_wrist(m: &Motion) -> f32 {
+    let peak = |j: usize| {
+        m.frames
+            .iter()
+            .map(|f| f[j].y)
+            .reduce(f32::max)
+            .unwrap_or(0.0)
+    };
+    peak(WRISTS[1]) - peak(WRISTS[0])
+}
+
 /// Every per-motion metric at once.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct MotionMetrics {
@@ -234,6 +246,8 @@ pub struct MotionMetrics {
     pub turn_deg: f32,
     /// [`wrists_above_head`].
     pub wrists_above_head: f32,
+    /// [`right_minus_left_wrist`].
+    pub wrist_side: f32,
 }
 
 impl MotionMetrics {
@@ -247,6 +261,7 @@ impl MotionMetrics {
             speed: mean_root_speed(m),
             turn_deg: total_turn(m),
             wrists_above_head: wrists_above_head(m),
+            wrist_side: right_minus_left_wrist(m),
         }
     }
 }
@@ -306,7 +321,9 @@ mod tests {
 
     #[test]
     fn skating_needs_both_frames_of_a_step_in_contact() {
-        let pos: Vec<Vec3> = (0..8).map(|t| Vec3::new(0.05 * t as f32, 0.0, 0.0)).collect();
+        let pos: Vec<Vec3> = (0..8)
+            .map(|t| Vec3::new(0.05 * t as f32, 0.0, 0.0))
+            .collect();
         let mut m = shifted(&pos);
         for (t, f) in m.frames.iter_mut().enumerate() {
             f[10].y = 0.0;
@@ -360,7 +377,10 @@ mod tests {
     #[test]
     fn penetration_depth_and_fraction() {
         let mut m = shifted(&[Vec3::ZERO; 4]);
-        let lowest = m.frames[0].iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
+        let lowest = m.frames[0]
+            .iter()
+            .map(|p| p.y)
+            .fold(f32::INFINITY, f32::min);
         for f in &mut m.frames {
             for p in f.iter_mut() {
                 p.y -= lowest; // lowest joint exactly on the floor
@@ -424,5 +444,10 @@ mod tests {
         approx(wrists_above_head(&m), below, 1e-6);
         m.frames[1][21].y = head + 0.25;
         approx(wrists_above_head(&m), 0.25, 1e-6);
+        // Right wrist 21 peaks at head + 0.25, the left one stays at its rest height.
+        let left_rest = m.frames[0][20].y;
+        approx(right_minus_left_wrist(&m), head + 0.25 - left_rest, 1e-6);
+        m.frames[2][20].y = head + 0.5;
+        approx(right_minus_left_wrist(&m), -0.25, 1e-6);
     }
 }

@@ -59,7 +59,7 @@ pub struct EvalSettings {
 impl Default for EvalSettings {
     fn default() -> Self {
         EvalSettings {
-            count: 48,
+            count: 32,
             seed: 1,
             sampler: SamplerKind::Ddim(50),
             guidance_scale: 2.5,
@@ -114,6 +114,8 @@ pub struct LabelStats {
     pub turn_range: (f32, f32),
     /// Mean highest wrist above head (m).
     pub wrists: f32,
+    /// Mean right-minus-left wrist peak height (m).
+    pub wrist_side: f32,
     /// Mean foot skating ratio.
     pub skating: f32,
 }
@@ -254,6 +256,7 @@ pub fn mean_metrics(motions: &[Motion]) -> MotionMetrics {
         m.speed += x.speed / n;
         m.turn_deg += x.turn_deg / n;
         m.wrists_above_head += x.wrists_above_head / n;
+        m.wrist_side += x.wrist_side / n;
     }
     m
 }
@@ -299,6 +302,7 @@ fn label_stats(motions: &[Motion]) -> LabelStats {
             turns.fold(f32::NEG_INFINITY, f32::max),
         ),
         wrists: m.wrists_above_head,
+        wrist_side: m.wrist_side,
         skating: m.skating,
     }
 }
@@ -313,13 +317,15 @@ pub fn run_eval(
     device: &Device,
     log: &mut dyn FnMut(&str),
 ) -> Result<(EvalReport, Vec<Sample>), EvalError> {
-    if bundle.config.features != FEATURE_DIM || evaluator.manifest.config.features != FEATURE_DIM
-    {
+    if bundle.config.features != FEATURE_DIM || evaluator.manifest.config.features != FEATURE_DIM {
         return Err(EvalError::Invalid(format!(
             "model and evaluator must both read {FEATURE_DIM} features"
         )));
     }
-    let cap = bundle.config.max_frames.min(evaluator.manifest.config.max_frames);
+    let cap = bundle
+        .config
+        .max_frames
+        .min(evaluator.manifest.config.max_frames);
     let eligible: Vec<&ClipInfo> = data
         .clips(Split::Test)
         .filter(|c| c.frames >= settings.min_frames.max(2) && !c.captions.is_empty())
@@ -363,7 +369,8 @@ pub fn run_eval(
         .iter()
         .map(|c| &data.clip_features(c)[..c.frames.min(cap) * FEATURE_DIM])
         .collect();
-    let distractor_captions: Vec<String> = eligible.iter().map(|c| pick_caption(c, &mut rng)).collect();
+    let distractor_captions: Vec<String> =
+        eligible.iter().map(|c| pick_caption(c, &mut rng)).collect();
     let captions: Vec<&str> = distractor_captions.iter().map(String::as_str).collect();
     let reference = Reference {
         embeddings: evaluator.embed_motions(&ref_rows, device)?,
@@ -469,10 +476,7 @@ pub fn run_eval(
         rows,
         labels,
         model: (bundle.manifest.weights_id.clone(), bundle.manifest.steps),
-        evaluator: (
-            evaluator.manifest.steps,
-            evaluator.manifest.val_r_precision,
-        ),
+        evaluator: (evaluator.manifest.steps, evaluator.manifest.val_r_precision),
         reference_clips: reference_clips.len(),
         settings: settings.clone(),
         generate_seconds,

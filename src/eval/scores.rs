@@ -98,7 +98,12 @@ pub fn frechet_distance(a: &Gaussian, b: &Gaussian) -> Result<f64, ScoreError> {
         )));
     }
     let n = a.dim;
-    let mean: f64 = a.mean.iter().zip(&b.mean).map(|(x, y)| (x - y).powi(2)).sum();
+    let mean: f64 = a
+        .mean
+        .iter()
+        .zip(&b.mean)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum();
     let tr = |c: &[f64]| (0..n).map(|i| c[i * n + i]).sum::<f64>();
     let cross = trace_sqrt_product(&a.cov, &b.cov, n)?;
     // Never below 0 (rounding can leave −1e-12).
@@ -125,7 +130,9 @@ pub const DIVERSITY_PAIRS: usize = 300;
 pub fn diversity(rows: &[Vec<f32>], pairs: usize, seed: u64) -> Result<f64, ScoreError> {
     check_rows(rows, 2, "diversity")?;
     if pairs == 0 {
-        return Err(ScoreError::Invalid("diversity needs at least one pair".into()));
+        return Err(ScoreError::Invalid(
+            "diversity needs at least one pair".into(),
+        ));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let n = rows.len();
@@ -167,7 +174,11 @@ pub fn r_precision(
             "R-precision needs one caption and one group per motion".into(),
         ));
     }
-    if texts.iter().chain(distractors.iter().map(|d| &d.embedding)).any(|t| t.len() != dim) {
+    if texts
+        .iter()
+        .chain(distractors.iter().map(|d| &d.embedding))
+        .any(|t| t.len() != dim)
+    {
         return Err(ScoreError::Invalid(
             "R-precision: text and motion embeddings differ in width".into(),
         ));
@@ -222,21 +233,65 @@ mod tests {
         let a = cloud(200, 16, 0.0, 1);
         assert!(fid(&a, &a).unwrap() < 1e-6);
         // A pure shift by d in every dimension adds exactly ‖d‖² = 16 d².
-        let shifted: Vec<Vec<f32>> = a.iter().map(|r| r.iter().map(|v| v + 0.5).collect()).collect();
+        let shifted: Vec<Vec<f32>> = a
+            .iter()
+            .map(|r| r.iter().map(|v| v + 0.5).collect())
+            .collect();
         assert!((fid(&a, &shifted).unwrap() - 16.0 * 0.25).abs() < 1e-4);
-        let far: Vec<Vec<f32>> = a.iter().map(|r| r.iter().map(|v| v + 1.0).collect()).collect();
+        let far: Vec<Vec<f32>> = a
+            .iter()
+            .map(|r| r.iter().map(|v| v + 1.0).collect())
+            .collect();
         assert!(fid(&a, &far).unwrap() > fid(&a, &shifted).unwrap());
         // Two samples of the same distribution are close; a scaled one is not.
         let b = cloud(200, 16, 0.0, 2);
-        let scaled: Vec<Vec<f32>> = b.iter().map(|r| r.iter().map(|v| v * 2.0).collect()).collect();
+        let scaled: Vec<Vec<f32>> = b
+            .iter()
+            .map(|r| r.iter().map(|v| v * 2.0).collect())
+            .collect();
         assert!(fid(&a, &b).unwrap() < 0.2 * fid(&a, &scaled).unwrap());
+    }
+
+    #[test]
+    fn fid_of_few_samples_in_256_dimensions() {
+        // 48 unit embeddings against 300 references in 256-d, as in `mprog eval`: both
+        // covariances are singular (rank 47 for the small set); the result is finite, ≈ 0
+        // for a set with itself, and a shift by 0.01 in every dimension adds 256 · 1e-4.
+        let unit = |rows: Vec<Vec<f32>>| -> Vec<Vec<f32>> {
+            rows.into_iter()
+                .map(|r| {
+                    let n = r.iter().map(|v| v * v).sum::<f32>().sqrt();
+                    r.into_iter().map(|v| v / n).collect()
+                })
+                .collect()
+        };
+        let a = unit(cloud(48, 256, 0.0, 4));
+        let r = unit(cloud(300, 256, 0.0, 5));
+        assert!(fid(&a, &a).unwrap() < 1e-6);
+        let base = fid(&a, &r).unwrap();
+        let shift = |rows: &[Vec<f32>], d: f32| -> Vec<Vec<f32>> {
+            rows.iter()
+                .map(|x| x.iter().map(|v| v + d).collect())
+                .collect()
+        };
+        assert!(base.is_finite() && fid(&shift(&a, 0.05), &r).unwrap() > base);
+        let moved = fid(&a, &shift(&a, 0.01)).unwrap();
+        assert!((moved - 0.0256).abs() < 1e-4, "{moved}");
     }
 
     #[test]
     fn fid_of_one_dimensional_gaussians_matches_the_closed_form() {
         // 1-D: (μ₁ − μ₂)² + (σ₁ − σ₂)².
-        let a = Gaussian { dim: 1, mean: vec![1.0], cov: vec![4.0] };
-        let b = Gaussian { dim: 1, mean: vec![3.0], cov: vec![9.0] };
+        let a = Gaussian {
+            dim: 1,
+            mean: vec![1.0],
+            cov: vec![4.0],
+        };
+        let b = Gaussian {
+            dim: 1,
+            mean: vec![3.0],
+            cov: vec![9.0],
+        };
         assert!((frechet_distance(&a, &b).unwrap() - (4.0 + 1.0)).abs() < 1e-12);
     }
 
@@ -251,13 +306,20 @@ mod tests {
     fn r_precision_ranks_the_own_caption() {
         // 40 one-hot-ish "labels"; motion i sits on its caption, at distance 0.
         let dim = 40;
-        let onehot = |k: usize| (0..dim).map(|d| (d == k) as u8 as f32).collect::<Vec<f32>>();
+        let onehot = |k: usize| {
+            (0..dim)
+                .map(|d| (d == k) as u8 as f32)
+                .collect::<Vec<f32>>()
+        };
         let texts: Vec<Vec<f32>> = (0..dim).map(onehot).collect();
         let groups: Vec<String> = (0..dim).map(|k| format!("g{k}")).collect();
         let distractors: Vec<Distractor> = texts
             .iter()
             .zip(&groups)
-            .map(|(t, g)| Distractor { embedding: t.clone(), group: g.clone() })
+            .map(|(t, g)| Distractor {
+                embedding: t.clone(),
+                group: g.clone(),
+            })
             .collect();
         let perfect = r_precision(&texts, &texts, &groups, &distractors, 3).unwrap();
         assert_eq!(perfect, [1.0, 1.0, 1.0]);

@@ -94,12 +94,13 @@ fn side(s: &LabelStats) -> Option<&LabelStats> {
 pub fn labels_markdown(r: &EvalReport) -> String {
     let mut out = String::from(
         "| label | clips real / gen | speed m/s real / gen | total turn (deg) real / gen (gen range) | \
-         wrists above head (m) real / gen | foot skating real / gen |\n\
-         | --- | --- | --- | --- | --- | --- |\n",
+         wrists above head (m) real / gen | right − left wrist (m) real / gen | \
+         foot skating real / gen |\n\
+         | --- | --- | --- | --- | --- | --- | --- |\n",
     );
     for row in &r.labels {
         let Some(real) = side(&row.real) else {
-            let _ = writeln!(out, "| {} | 0 / 0 | – | – | – | – |", row.label);
+            let _ = writeln!(out, "| {} | 0 / 0 | – | – | – | – | – |", row.label);
             continue;
         };
         let generated = row.generated.as_ref().and_then(side);
@@ -112,20 +113,22 @@ pub fn labels_markdown(r: &EvalReport) -> String {
         };
         let _ = writeln!(
             out,
-            "| {} | {} / {} | {} | {} | {} | {} |",
+            "| {} | {} / {} | {} | {} | {} | {} | {} |",
             row.label,
             real.count,
             generated.map_or(0, |g| g.count),
             pair(real.speed, generated.map(|g| g.speed), 2),
             turn,
             pair(real.wrists, generated.map(|g| g.wrists), 2),
+            pair(real.wrist_side, generated.map(|g| g.wrist_side), 2),
             pair(real.skating, generated.map(|g| g.skating), 2),
         );
     }
     out.push_str(
         "\nTotal turn: net heading change of the pelvis path where it moves faster than \
          0.1 m/s, + = left (Y up). Wrists above head: max over frames of the higher wrist's \
-         height minus the head's.\n",
+         height minus the head's. Right − left wrist: peak height of the right wrist minus \
+         the left's (+ = the right hand went higher).\n",
     );
     out
 }

@@ -82,7 +82,10 @@ fn synthetic_dataset(per_split: [usize; 3]) -> Dataset {
     let mut features = Vec::new();
     let mut joints = Vec::new();
     let mut offset = 0;
-    for (s, split) in [Split::Train, Split::Val, Split::Test].into_iter().enumerate() {
+    for (s, split) in [Split::Train, Split::Val, Split::Test]
+        .into_iter()
+        .enumerate()
+    {
         for (l, (label, caption)) in LABELS.iter().enumerate() {
             for i in 0..per_split[s] {
                 let frames = 40 + 7 * (i % 4);
@@ -116,7 +119,11 @@ fn synthetic_dataset(per_split: [usize; 3]) -> Dataset {
             version: 1,
             fps: 20.0,
             clips,
-            stats: [SplitStats::default(), SplitStats::default(), SplitStats::default()],
+            stats: [
+                SplitStats::default(),
+                SplitStats::default(),
+                SplitStats::default(),
+            ],
             skipped: vec![],
             build_seconds: 0.0,
         },
@@ -160,8 +167,13 @@ fn encoder_training_lowers_the_contrastive_loss() {
     // Four labels, 12 clips a batch: the trained encoder puts a walk nearer its caption
     // than the wave caption.
     let dev = Device::flex();
-    let walk = data.clips(Split::Train).find(|c| c.content == "walk").unwrap();
-    let m = evaluator.embed_motions(&[data.clip_features(walk)], &dev).unwrap();
+    let walk = data
+        .clips(Split::Train)
+        .find(|c| c.content == "walk")
+        .unwrap();
+    let m = evaluator
+        .embed_motions(&[data.clip_features(walk)], &dev)
+        .unwrap();
     let t = evaluator
         .embed_captions(&[LABELS[0].1, LABELS[2].1], &dev)
         .unwrap();
@@ -204,7 +216,11 @@ fn evaluator_files_round_trip_and_mismatches_are_refused() {
     let rows = [data.clip_features(&data.index.clips[0])];
     let a = evaluator.embed_motions(&rows, &dev).unwrap();
     let b = loaded.embed_motions(&rows, &dev).unwrap();
-    let diff = a[0].iter().zip(&b[0]).map(|(x, y)| (x - y).abs()).fold(0.0, f32::max);
+    let diff = a[0]
+        .iter()
+        .zip(&b[0])
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f32::max);
     assert!(diff < 1e-2, "f16 round trip changed an embedding by {diff}");
     // A manifest claiming another shape: the weights no longer fit.
     let manifest_path = dir.path().join("manifest.json");
@@ -239,7 +255,10 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
         ..ModelConfig::default()
     };
     let vocab = Vocabulary::from_captions(
-        data.index.clips.iter().flat_map(|c| c.captions.iter().map(String::as_str)),
+        data.index
+            .clips
+            .iter()
+            .flat_map(|c| c.captions.iter().map(String::as_str)),
         16,
     );
     ModelBundle {
@@ -273,13 +292,19 @@ fn eval_runs_end_to_end_on_a_tiny_dataset_and_model() {
         ..EvalSettings::default()
     };
     let mut lines = Vec::new();
-    let (report, samples) =
-        run_eval(&data, &bundle, &evaluator, &settings, &dev, &mut |l| lines.push(l.to_string()))
-            .unwrap();
+    let (report, samples) = run_eval(&data, &bundle, &evaluator, &settings, &dev, &mut |l| {
+        lines.push(l.to_string())
+    })
+    .unwrap();
     assert!(lines.iter().any(|l| l.contains("8 prompts")), "{lines:?}");
     assert_eq!(report.rows.len(), 3);
     let [real, model, frozen] = [&report.rows[0], &report.rows[1], &report.rows[2]];
-    assert!(report.rows.iter().all(|r| r.count == 8 && r.fid.is_finite()));
+    assert!(
+        report
+            .rows
+            .iter()
+            .all(|r| r.count == 8 && r.fid.is_finite())
+    );
     // Real clips: no sliding, rigid bones, at rest on the floor; the frozen baseline
     // does not move at all and has no diversity of motion beyond its first poses.
     assert_eq!(frozen.metrics.max_accel, 0.0);
@@ -294,12 +319,30 @@ fn eval_runs_end_to_end_on_a_tiny_dataset_and_model() {
     let walk = &report.labels[0];
     assert!((walk.real.speed - 1.05).abs() < 0.1, "{:?}", walk.real);
     assert_eq!(walk.generated.as_ref().unwrap().count, 2);
-    assert!(report.labels[2].generated.is_none(), "no raise-up-both-hands clips");
-    assert!(report.labels[5].real.wrists > 0.1, "{:?}", report.labels[5].real);
+    assert!(
+        report.labels[2].generated.is_none(),
+        "no raise-up-both-hands clips"
+    );
+    assert!(
+        report.labels[5].real.wrists > 0.1,
+        "{:?}",
+        report.labels[5].real
+    );
+    assert!(
+        report.labels[5].real.wrist_side > 0.3,
+        "the right hand waves"
+    );
     assert_eq!(samples.len(), 8 + 3 * 2);
-    assert!(samples.iter().all(|s| s.motion.len() >= 40 && s.motion.len() <= 50));
+    assert!(
+        samples
+            .iter()
+            .all(|s| s.motion.len() >= 40 && s.motion.len() <= 50)
+    );
     let text = report_markdown(&report);
-    assert!(text.contains("| real test data | 8 |") && text.contains("tiny-random"), "{text}");
+    assert!(
+        text.contains("| real test data | 8 |") && text.contains("tiny-random"),
+        "{text}"
+    );
     assert!(text.contains("| raise-up-both-hands | 0 / 0 |"), "{text}");
     // Same seed, same report.
     let (again, _) = run_eval(&data, &bundle, &evaluator, &settings, &dev, &mut |_| {}).unwrap();

@@ -80,7 +80,9 @@ fn draw_batch<'a>(
     rng: &mut ChaCha8Rng,
 ) -> Batch<'a> {
     let b = cfg.batch_size;
-    let chosen: Vec<&ClipInfo> = (0..b).map(|_| clips[rng.random_range(0..clips.len())]).collect();
+    let chosen: Vec<&ClipInfo> = (0..b)
+        .map(|_| clips[rng.random_range(0..clips.len())])
+        .collect();
     let mut crops = Vec::with_capacity(b);
     let mut captions = Vec::with_capacity(b);
     for clip in &chosen {
@@ -125,7 +127,9 @@ fn batch_loss(
         device,
     );
     let m = net.motion.forward(x, valid); // [B, D]
-    let t = net.text.forward(&TokenBatch::new(vocab, &batch.captions, device)); // [B, D]
+    let t = net
+        .text
+        .forward(&TokenBatch::new(vocab, &batch.captions, device)); // [B, D]
     let logits = m.matmul(t.transpose()).div_scalar(cfg.encoder.temperature); // [B, B]
     let b = cfg.batch_size;
     let p: Tensor<2> = Tensor::from_data(TensorData::new(batch.targets.clone(), [b, b]), device);
@@ -208,7 +212,9 @@ pub fn train_evaluator(
         ));
     }
     let vocab = Vocabulary::from_captions(
-        clips.iter().flat_map(|c| c.captions.iter().map(String::as_str)),
+        clips
+            .iter()
+            .flat_map(|c| c.captions.iter().map(String::as_str)),
         16,
     );
     let plain = Device::flex();
