@@ -35,30 +35,48 @@ fn book_pages() -> Vec<PathBuf> {
 /// The block's text with mdBook `{{#include path}}` lines replaced by the file.
 fn resolve_includes(text: &str, page: &Path) -> String {
     text.lines()
-        .map(|l| match l.trim().strip_prefix("{{#include ").and_then(|r| r.strip_suffix("}}")) {
-            Some(rel) => {
-                let path = page.parent().unwrap().join(rel.trim());
-                std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: include {}: {e}", page.display(), path.display()))
+        .map(|l| {
+            match l
+                .trim()
+                .strip_prefix("{{#include ")
+                .and_then(|r| r.strip_suffix("}}"))
+            {
+                Some(rel) => {
+                    let path = page.parent().unwrap().join(rel.trim());
+                    std::fs::read_to_string(&path).unwrap_or_else(|e| {
+                        panic!("{}: include {}: {e}", page.display(), path.display())
+                    })
+                }
+                None => format!("{l}\n"),
             }
-            None => format!("{l}\n"),
         })
         .collect()
 }
 
 fn check_block(page: &Path, b: &CodeBlock) -> Result<(), String> {
-    let what = format!("{}:{}", page.strip_prefix(root()).unwrap_or(page).display(), b.line);
+    let what = format!(
+        "{}:{}",
+        page.strip_prefix(root()).unwrap_or(page).display(),
+        b.line
+    );
     let src = resolve_includes(&b.text, page);
     match b.attrs.first().map(String::as_str) {
         None => compile(&src, &what, &[])
             .map(|_| ())
             .map_err(|d| format!("{what}: block does not compile:\n{}", d.render_plain())),
         Some("error") => {
-            let code = b.attrs.get(1).ok_or(format!("{what}: `mprog,error` names no code"))?;
+            let code = b
+                .attrs
+                .get(1)
+                .ok_or(format!("{what}: `mprog,error` names no code"))?;
             let d = check_source(&src, &what, &[]);
             if d.has_errors() && d.items.iter().any(|i| i.code == code) {
                 Ok(())
             } else {
-                Err(format!("{what}: expected {code}, got:\n{}", d.render_plain()))
+                Err(format!(
+                    "{what}: expected {code}, got:\n{}",
+                    d.render_plain()
+                ))
             }
         }
         Some("repl") => replay(&what, &src),
@@ -92,14 +110,25 @@ fn replay(what: &str, transcript: &str) -> Result<(), String> {
         let got: Vec<&str> = got.lines().collect();
         // A last expected line of just `…` matches the rest of the output.
         let open_end = expected.last().is_some_and(|l| l.trim() == "…");
-        let fixed = if open_end { &expected[..expected.len() - 1] } else { &expected[..] };
+        let fixed = if open_end {
+            &expected[..expected.len() - 1]
+        } else {
+            &expected[..]
+        };
         let ok = (got.len() == fixed.len() || (open_end && got.len() >= fixed.len()))
-            && got.iter().zip(fixed).all(|(g, e)| match e.strip_suffix('…') {
-                Some(prefix) => g.starts_with(prefix),
-                None => g.trim_end() == e.trim_end(),
-            });
+            && got
+                .iter()
+                .zip(fixed)
+                .all(|(g, e)| match e.strip_suffix('…') {
+                    Some(prefix) => g.starts_with(prefix),
+                    None => g.trim_end() == e.trim_end(),
+                });
         if !ok {
-            return Err(format!("{what}: `{input}` printed\n{}\nexpected\n{}", got.join("\n"), expected.join("\n")));
+            return Err(format!(
+                "{what}: `{input}` printed\n{}\nexpected\n{}",
+                got.join("\n"),
+                expected.join("\n")
+            ));
         }
     }
     Ok(())
@@ -136,7 +165,10 @@ fn generated_pages_are_up_to_date() {
     if summary_with_cookbook(&summary, &programs).as_deref() != Some(summary.as_str()) {
         stale.push("SUMMARY.md".into());
     }
-    assert!(stale.is_empty(), "stale book pages (run `cargo run -- doc book`): {stale:?}");
+    assert!(
+        stale.is_empty(),
+        "stale book pages (run `cargo run -- doc book`): {stale:?}"
+    );
 }
 
 #[test]
@@ -145,26 +177,54 @@ fn every_summary_link_exists() {
     let summary = std::fs::read_to_string(src.join("SUMMARY.md")).unwrap();
     for part in summary.split("](").skip(1) {
         let link = part.split(')').next().unwrap();
-        assert!(src.join(link).exists(), "SUMMARY.md links to missing {link}");
+        assert!(
+            src.join(link).exists(),
+            "SUMMARY.md links to missing {link}"
+        );
     }
 }
 
 #[test]
 fn prompt_examples_compile_and_cover_the_library() {
     let prompt = system_prompt();
-    let blocks: Vec<CodeBlock> = code_blocks(&prompt).into_iter().filter(|b| b.lang == "mprog").collect();
-    assert_eq!(blocks.len(), EXAMPLES.len() + 1, "the language sketch and the worked examples");
+    let blocks: Vec<CodeBlock> = code_blocks(&prompt)
+        .into_iter()
+        .filter(|b| b.lang == "mprog")
+        .collect();
+    assert_eq!(
+        blocks.len(),
+        EXAMPLES.len() + 1,
+        "the language sketch and the worked examples"
+    );
     assert_eq!(EXAMPLES.len(), 5);
     for b in &blocks {
         let diags = check_source(&b.text, "prompt", &[]);
-        assert!(!diags.has_errors(), "prompt block at line {}:\n{}\n{}", b.line, b.text, diags.render_plain());
-        assert!(diags.items.is_empty(), "prompt block at line {} has warnings:\n{}", b.line, diags.render_plain());
+        assert!(
+            !diags.has_errors(),
+            "prompt block at line {}:\n{}\n{}",
+            b.line,
+            b.text,
+            diags.render_plain()
+        );
+        assert!(
+            diags.items.is_empty(),
+            "prompt block at line {} has warnings:\n{}",
+            b.line,
+            diags.render_plain()
+        );
     }
     for name in JOINT_NAMES.iter().chain(ALIASES.iter().map(|(a, _)| a)) {
-        assert!(prompt.contains(&format!("`{name}`")), "prompt lacks joint {name}");
+        assert!(
+            prompt.contains(&format!("`{name}`")),
+            "prompt lacks joint {name}"
+        );
     }
     for d in mprog::lang::stdlib::docs() {
-        assert!(prompt.contains(&d.signature), "prompt lacks {}", d.signature);
+        assert!(
+            prompt.contains(&d.signature),
+            "prompt lacks {}",
+            d.signature
+        );
     }
     for b in mprog::lang::check::builtins::BUILTINS {
         assert!(prompt.contains(b.signature), "prompt lacks {}", b.signature);

@@ -55,7 +55,10 @@ fn statements_accumulate_and_clear() {
     let added = say(&mut s, "head.y > bar");
     assert!(added.contains("line 3: head.y > bar"), "{added}");
     let shown = say(&mut s, ":show");
-    assert!(shown.contains("  1 │ length 2s") && shown.contains("  3 │ head.y > bar"), "{shown}");
+    assert!(
+        shown.contains("  1 │ length 2s") && shown.contains("  3 │ head.y > bar"),
+        "{shown}"
+    );
     say(&mut s, "always {\n  pelvis.z < 10 m\n}");
     assert_eq!(s.program().unwrap().statements().len(), 2);
     say(&mut s, ":clear");
@@ -84,7 +87,10 @@ fn eval_of_a_scalar_summarises_frames() {
     let mean = (lo + hi) / 2.0;
     let want = format!("min {:.3}  mean {:.3}  max {:.3}", lo, mean, hi);
     assert!(out.contains(&want), "{out}\nwant {want}");
-    assert!(out.contains('▁') && out.contains('█') && out.contains("frames 0–39"), "{out}");
+    assert!(
+        out.contains('▁') && out.contains('█') && out.contains("frames 0–39"),
+        "{out}"
+    );
 }
 
 #[test]
@@ -100,20 +106,32 @@ fn eval_of_a_statement_shows_its_error() {
     let mut s = session();
     // pelvis.z = 0.05 t: the error of `pelvis.z > 1 m` is max(1 − 0.05 t, 0).
     let out = say(&mut s, ":eval pelvis.z > 1 m");
-    let want: f32 = (0..F).map(|t| (1.0 - 0.05 * t as f32).max(0.0)).sum::<f32>() / F as f32;
-    assert!(out.contains(&format!("error {want:.4} m")), "{out}\nwant {want}");
+    let want: f32 = (0..F)
+        .map(|t| (1.0 - 0.05 * t as f32).max(0.0))
+        .sum::<f32>()
+        / F as f32;
+    assert!(
+        out.contains(&format!("error {want:.4} m")),
+        "{out}\nwant {want}"
+    );
     assert!(out.contains("zero at 20"), "{out}");
     let end = say(&mut s, ":eval at end { pelvis.z > 3 m }");
     assert!(end.contains("frame 39: 1.050"), "{end}");
     let during = say(&mut s, ":eval during 10..20 { pelvis.z > 1 m }");
-    assert!(during.contains("frames 10–19") && !during.contains('·'), "{during}");
+    assert!(
+        during.contains("frames 10–19") && !during.contains('·'),
+        "{during}"
+    );
 }
 
 #[test]
 fn eval_explains_bad_input() {
     let mut s = session();
     let out = fails(&mut s, ":eval head.w");
-    assert!(out.contains("mprog::unknown_component") && !out.contains("not_a_constraint"), "{out}");
+    assert!(
+        out.contains("mprog::unknown_component") && !out.contains("not_a_constraint"),
+        "{out}"
+    );
     let none = fails(&mut s, ":eval let q = 3");
     assert!(none.contains("nothing to evaluate"), "{none}");
     let mut empty = Session::new(None);
@@ -130,7 +148,10 @@ fn grad_ranks_the_joints_the_statement_moves() {
     let satisfied = say(&mut s, ":grad l_hand.y < 3 m");
     assert!(satisfied.contains("gradient is zero"), "{satisfied}");
     let two = say(&mut s, ":grad dist(l_hand, r_hand) < 10 cm");
-    assert!(two.contains("left_wrist") && two.contains("right_wrist"), "{two}");
+    assert!(
+        two.contains("left_wrist") && two.contains("right_wrist"),
+        "{two}"
+    );
     assert!(fails(&mut s, ":grad l_hand").contains("vector"));
 }
 
@@ -144,8 +165,16 @@ fn score_matches_program_evaluation() {
     let out = say(&mut s, ":score");
     let prog = compile(src, "x", &[]).unwrap();
     let m = walk();
-    let x = Tensor::<5>::from_data(TensorData::new(m.to_flat(), [1, 1, F, NUM_JOINTS, 3]), &Device::flex());
-    let total = prog.evaluate(x).total.into_data().try_into_vec::<f32>().unwrap()[0];
+    let x = Tensor::<5>::from_data(
+        TensorData::new(m.to_flat(), [1, 1, F, NUM_JOINTS, 3]),
+        &Device::flex(),
+    );
+    let total = prog
+        .evaluate(x)
+        .total
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap()[0];
     let want = format!("total {} on walk", mprog::repl::summary::num(total));
     assert!(out.contains(&want), "{out}\nwant {want}");
     assert_eq!(out.lines().count(), 4, "{out}");
@@ -156,17 +185,38 @@ fn per_frame_errors_average_to_the_statement_errors() {
     let src = "length 2s\nhead.y > 1.8 m\nif pelvis.z > 1 m { head.y > 1.9 m }\nduring 5..15 weight 2 { for f in [l_foot, r_foot] { f.y > 0.2 m } }\nat end { pelvis.z > 3 m }\n";
     let prog = compile(src, "x", &[]).unwrap();
     let m = walk();
-    let x = Tensor::<5>::from_data(TensorData::new(m.to_flat(), [1, 1, F, NUM_JOINTS, 3]), &Device::flex());
-    let per = prog.evaluate(x.clone()).per_statement.into_data().try_into_vec::<f32>().unwrap();
+    let x = Tensor::<5>::from_data(
+        TensorData::new(m.to_flat(), [1, 1, F, NUM_JOINTS, 3]),
+        &Device::flex(),
+    );
+    let per = prog
+        .evaluate(x.clone())
+        .per_statement
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap();
     let frames = prog.evaluate_frames(x).unwrap();
     assert_eq!(frames.len(), per.len());
     for (i, fe) in frames.iter().enumerate() {
-        let vals: Vec<f32> = fe.errors[0].iter().zip(&fe.applies[0]).filter(|(_, a)| **a).map(|(v, _)| *v).collect();
+        let vals: Vec<f32> = fe.errors[0]
+            .iter()
+            .zip(&fe.applies[0])
+            .filter(|(_, a)| **a)
+            .map(|(v, _)| *v)
+            .collect();
         let mean = vals.iter().sum::<f32>() / vals.len().max(1) as f32;
-        assert!((mean - per[i]).abs() < 1e-4, "statement {i}: per-frame mean {mean} vs {}", per[i]);
+        assert!(
+            (mean - per[i]).abs() < 1e-4,
+            "statement {i}: per-frame mean {mean} vs {}",
+            per[i]
+        );
     }
     assert_eq!(frames[2].frames, (5..15).collect::<Vec<_>>());
-    assert_eq!(frames[1].applies[0].iter().filter(|a| **a).count(), 19, "pelvis.z > 1 from frame 21");
+    assert_eq!(
+        frames[1].applies[0].iter().filter(|a| **a).count(),
+        19,
+        "pelvis.z > 1 from frame 21"
+    );
 }
 
 #[test]
@@ -175,14 +225,20 @@ fn files_commands_and_errors() {
     let mut s = Session::new(Some(dir.path().join("no-model")));
     assert!(fails(&mut s, ":motion /no/such/walk.bvh").contains("walk.bvh"));
     let gen_err = fails(&mut s, ":gen \"a person walks\" 2");
-    assert!(gen_err.contains("cannot load the model bundle") && gen_err.contains("--model"), "{gen_err}");
+    assert!(
+        gen_err.contains("cannot load the model bundle") && gen_err.contains("--model"),
+        "{gen_err}"
+    );
     let good = dir.path().join("good.mprog");
     std::fs::write(&good, "length 2s\nhead.y > 1 m\n").unwrap();
     let bad = dir.path().join("bad.mprog");
     std::fs::write(&bad, "length 2s\nhead.q > 1 m\n").unwrap();
     say(&mut s, &format!(":load {}", good.display()));
     let out = fails(&mut s, &format!(":load {}", bad.display()));
-    assert!(out.contains("unknown_component") && out.contains("not loaded"), "{out}");
+    assert!(
+        out.contains("unknown_component") && out.contains("not loaded"),
+        "{out}"
+    );
     assert_eq!(s.source(), "length 2s\nhead.y > 1 m\n");
     let npy = dir.path().join("walk.npy");
     mprog::formats::write_motion(&npy, &[walk()], &mprog::formats::Meta::new()).unwrap();
@@ -198,7 +254,10 @@ fn people_must_match_the_motion() {
     let mut s = session();
     say(&mut s, "people a \"a person\", b \"another\"");
     let out = fails(&mut s, ":eval a.head.y");
-    assert!(out.contains("2 person(s)") && out.contains("has 1"), "{out}");
+    assert!(
+        out.contains("2 person(s)") && out.contains("has 1"),
+        "{out}"
+    );
 }
 
 #[test]

@@ -58,7 +58,9 @@ impl Tmux {
 
 impl Drop for Tmux {
     fn drop(&mut self) {
-        let _ = Command::new("tmux").args(["-L", &self.socket, "kill-server"]).output();
+        let _ = Command::new("tmux")
+            .args(["-L", &self.socket, "kill-server"])
+            .output();
     }
 }
 
@@ -90,7 +92,17 @@ fn a_person_uses_the_repl_in_a_terminal() {
         state.display(),
         env!("CARGO_BIN_EXE_mprog")
     );
-    tmux.run(&["new-session", "-d", "-s", "repl", "-x", "160", "-y", "60", &cmd]);
+    tmux.run(&[
+        "new-session",
+        "-d",
+        "-s",
+        "repl",
+        "-x",
+        "160",
+        "-y",
+        "60",
+        &cmd,
+    ]);
     tmux.wait_for("mprog>");
     tmux.wait_for("40 frames");
 
@@ -128,10 +140,17 @@ fn a_person_uses_the_repl_in_a_terminal() {
     tmux.line(":quit");
     let start = Instant::now();
     while !state.join("mprog/history").exists() || tmux.run(&["list-sessions"]).contains("repl") {
-        assert!(start.elapsed() < Duration::from_secs(20), "the REPL did not quit:\n{}", tmux.screen());
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "the REPL did not quit:\n{}",
+            tmux.screen()
+        );
         std::thread::sleep(Duration::from_millis(100));
     }
     let history = std::fs::read_to_string(state.join("mprog/history")).unwrap();
-    assert!(history.contains(":grad l_hand.y > 3 m") && history.contains("always {"), "{history}");
+    assert!(
+        history.contains(":grad l_hand.y > 3 m") && history.contains("always {"),
+        "{history}"
+    );
     assert!(dir.path().join("walk.png").exists());
 }

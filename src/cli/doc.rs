@@ -30,7 +30,11 @@ pub fn run(cmd: DocCommand) -> Result<()> {
             print!("{}", mprog::docgen::library::stdlib_reference());
             Ok(())
         }
-        DocCommand::Book { dir, programs, check } => book(&dir, &programs, check),
+        DocCommand::Book {
+            dir,
+            programs,
+            check,
+        } => book(&dir, &programs, check),
     }
 }
 
@@ -66,7 +70,10 @@ fn book(dir: &std::path::Path, programs: &std::path::Path, check: bool) -> Resul
         println!("wrote {}", path.display());
     }
     if check && stale > 0 {
-        return Err(miette!(help = "run `cargo run -- doc book`", "{stale} generated page(s) are stale"));
+        return Err(miette!(
+            help = "run `cargo run -- doc book`",
+            "{stale} generated page(s) are stale"
+        ));
     }
     if stale == 0 {
         println!("book pages up to date");

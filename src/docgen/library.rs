@@ -3,8 +3,8 @@
 //! `stdlib/*.mprog`.
 
 use crate::lang::check::builtins::BUILTINS;
-use crate::lang::stdlib::{self, LibDoc};
 use crate::lang::check_source;
+use crate::lang::stdlib::{self, LibDoc};
 
 /// A library item's description without its `Example:` line, on one line.
 pub fn description(doc: &str) -> String {
@@ -39,7 +39,11 @@ pub fn signature_lines() -> Vec<String> {
         .iter()
         .map(|b| format!("{} — {}", b.signature, b.doc))
         .collect();
-    out.extend(stdlib::docs().iter().map(|d| format!("{} — {}", d.signature, description(&d.doc))));
+    out.extend(
+        stdlib::docs()
+            .iter()
+            .map(|d| format!("{} — {}", d.signature, description(&d.doc))),
+    );
     out
 }
 
@@ -70,7 +74,9 @@ pub fn stdlib_reference() -> String {
         ));
     }
     for (file, _) in stdlib::FILES {
-        let title = file.trim_start_matches("stdlib/").trim_end_matches(".mprog");
+        let title = file
+            .trim_start_matches("stdlib/")
+            .trim_end_matches(".mprog");
         s.push_str(&format!("## `{file}` ({title})\n\n"));
         for d in stdlib::docs().iter().filter(|d| d.file == *file) {
             s.push_str(&lib_item(d));

@@ -23,7 +23,10 @@ pub fn code_blocks(md: &str) -> Vec<CodeBlock> {
         match open.as_mut() {
             None => {
                 if let Some(info) = trimmed.strip_prefix("```") {
-                    let mut words = info.split([',', ' ']).filter(|w| !w.is_empty()).map(str::to_string);
+                    let mut words = info
+                        .split([',', ' '])
+                        .filter(|w| !w.is_empty())
+                        .map(str::to_string);
                     open = Some(CodeBlock {
                         lang: words.next().unwrap_or_default(),
                         attrs: words.collect(),
@@ -54,7 +57,10 @@ mod tests {
         let md = "text\n```mprog\nhead.y > 1\n```\n\n```mprog,error mprog::unknown_joint\nx\n```\n```\nplain\n```\n";
         let b = code_blocks(md);
         assert_eq!(b.len(), 3);
-        assert_eq!((b[0].lang.as_str(), b[0].text.as_str(), b[0].line), ("mprog", "head.y > 1\n", 2));
+        assert_eq!(
+            (b[0].lang.as_str(), b[0].text.as_str(), b[0].line),
+            ("mprog", "head.y > 1\n", 2)
+        );
         assert_eq!(b[1].attrs, vec!["error", "mprog::unknown_joint"]);
         assert_eq!(b[2].lang, "");
     }

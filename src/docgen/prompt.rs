@@ -74,10 +74,19 @@ always { separation(a, b, 0.4 m) }
 
 fn joints_section() -> String {
     let rest = rest_pose();
-    let mut s = String::from("| index | joint | aliases | rest height (m) |\n| --- | --- | --- | --- |\n");
+    let mut s =
+        String::from("| index | joint | aliases | rest height (m) |\n| --- | --- | --- | --- |\n");
     for (i, name) in JOINT_NAMES.iter().enumerate() {
-        let aliases: Vec<String> = ALIASES.iter().filter(|(_, j)| *j == i).map(|(a, _)| format!("`{a}`")).collect();
-        s.push_str(&format!("| {i} | `{name}` | {} | {:.2} |\n", aliases.join(", "), rest[i].y));
+        let aliases: Vec<String> = ALIASES
+            .iter()
+            .filter(|(_, j)| *j == i)
+            .map(|(a, _)| format!("`{a}`"))
+            .collect();
+        s.push_str(&format!(
+            "| {i} | `{name}` | {} | {:.2} |\n",
+            aliases.join(", "),
+            rest[i].y
+        ));
     }
     s
 }
@@ -95,7 +104,10 @@ pub fn system_prompt() -> String {
     s.push_str(SEMANTICS);
     s.push_str("\n## Worked examples\n");
     for (i, (task, program)) in EXAMPLES.iter().enumerate() {
-        s.push_str(&format!("\n### Example {}: {task}\n\n```mprog\n{program}```\n", i + 1));
+        s.push_str(&format!(
+            "\n### Example {}: {task}\n\n```mprog\n{program}```\n",
+            i + 1
+        ));
     }
     s.push_str(RULES);
     s

@@ -64,16 +64,61 @@ pub struct CommandDoc {
 
 /// Every command, in `:help` order.
 pub const COMMANDS: &[CommandDoc] = &[
-    doc("load", &["l"], "FILE.mprog", "replace the session's program with a file"),
-    doc("motion", &["m"], "FILE", "load the current motion (.bvh, .npy, .json)"),
-    doc("gen", &[], "\"PROMPT\" [SECONDS] [SEED]", "generate the current motion with the model (default 6 s, seed 1)"),
-    doc("eval", &["e"], "EXPR | STATEMENT", "value (or error) per frame of the current motion: min/mean/max and a sparkline"),
-    doc("grad", &["g"], "STATEMENT", "gradient magnitude of a statement's error per joint, top joints first"),
-    doc("score", &["s"], "", "the program's error per statement on the current motion"),
-    doc("render", &["r"], "OUT.gif | OUT.png", "draw the current motion"),
-    doc("show", &["p"], "", "print the session's program with line numbers"),
+    doc(
+        "load",
+        &["l"],
+        "FILE.mprog",
+        "replace the session's program with a file",
+    ),
+    doc(
+        "motion",
+        &["m"],
+        "FILE",
+        "load the current motion (.bvh, .npy, .json)",
+    ),
+    doc(
+        "gen",
+        &[],
+        "\"PROMPT\" [SECONDS] [SEED]",
+        "generate the current motion with the model (default 6 s, seed 1)",
+    ),
+    doc(
+        "eval",
+        &["e"],
+        "EXPR | STATEMENT",
+        "value (or error) per frame of the current motion: min/mean/max and a sparkline",
+    ),
+    doc(
+        "grad",
+        &["g"],
+        "STATEMENT",
+        "gradient magnitude of a statement's error per joint, top joints first",
+    ),
+    doc(
+        "score",
+        &["s"],
+        "",
+        "the program's error per statement on the current motion",
+    ),
+    doc(
+        "render",
+        &["r"],
+        "OUT.gif | OUT.png",
+        "draw the current motion",
+    ),
+    doc(
+        "show",
+        &["p"],
+        "",
+        "print the session's program with line numbers",
+    ),
     doc("clear", &[], "", "empty the session's program"),
-    doc("help", &["h", "?"], "[COMMAND]", "this list, or one command's help"),
+    doc(
+        "help",
+        &["h", "?"],
+        "[COMMAND]",
+        "this list, or one command's help",
+    ),
     doc("quit", &["q", "exit"], "", "leave (Ctrl-D works too)"),
 ];
 
@@ -217,7 +262,10 @@ mod tests {
     #[test]
     fn commands_and_aliases() {
         assert_eq!(cmd(":load a.mprog"), Command::Load("a.mprog".into()));
-        assert_eq!(cmd(":l \"my prog.mprog\""), Command::Load("my prog.mprog".into()));
+        assert_eq!(
+            cmd(":l \"my prog.mprog\""),
+            Command::Load("my prog.mprog".into())
+        );
         assert_eq!(cmd(":m walk.bvh"), Command::Motion("walk.bvh".into()));
         assert_eq!(cmd(":e head.y"), Command::Eval("head.y".into()));
         assert_eq!(cmd(":grad head.y > 1"), Command::Grad("head.y > 1".into()));
@@ -246,7 +294,14 @@ mod tests {
                 seed: 7
             }
         );
-        for bad in [":gen walk", ":gen \"walk", ":gen \"\"", ":gen \"w\" -1", ":gen \"w\" 2 x", ":gen \"w\" 2 3 4"] {
+        for bad in [
+            ":gen walk",
+            ":gen \"walk",
+            ":gen \"\"",
+            ":gen \"w\" -1",
+            ":gen \"w\" 2 x",
+            ":gen \"w\" 2 3 4",
+        ] {
             let e = parse(bad).unwrap_err();
             assert!(e.contains("usage: :gen"), "{bad}: {e}");
         }
@@ -254,9 +309,17 @@ mod tests {
 
     #[test]
     fn wrong_commands_explain() {
-        assert!(parse(":frobnicate").unwrap_err().contains("unknown command `:frobnicate`"));
+        assert!(
+            parse(":frobnicate")
+                .unwrap_err()
+                .contains("unknown command `:frobnicate`")
+        );
         assert!(parse(":load").unwrap_err().contains("needs a program file"));
-        assert!(parse(":score now").unwrap_err().contains("takes no argument"));
+        assert!(
+            parse(":score now")
+                .unwrap_err()
+                .contains("takes no argument")
+        );
     }
 
     #[test]

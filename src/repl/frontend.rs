@@ -34,7 +34,12 @@ pub struct ReplHelper {
 impl Completer for ReplHelper {
     type Candidate = Pair;
 
-    fn complete(&self, line: &str, pos: usize, ctx: &rustyline::Context<'_>) -> rustyline::Result<(usize, Vec<Pair>)> {
+    fn complete(
+        &self,
+        line: &str,
+        pos: usize,
+        ctx: &rustyline::Context<'_>,
+    ) -> rustyline::Result<(usize, Vec<Pair>)> {
         let (start, kind) = complete::word_at(line, pos);
         let words = match kind {
             WordContext::File => return self.files.complete(line, pos, ctx),
@@ -75,7 +80,11 @@ pub fn history_path() -> Option<PathBuf> {
     let state = std::env::var_os("XDG_STATE_HOME")
         .filter(|v| !v.is_empty())
         .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").filter(|v| !v.is_empty()).map(|h| PathBuf::from(h).join(".local/state")))?;
+        .or_else(|| {
+            std::env::var_os("HOME")
+                .filter(|v| !v.is_empty())
+                .map(|h| PathBuf::from(h).join(".local/state"))
+        })?;
     Some(state.join("mprog").join("history"))
 }
 
@@ -89,7 +98,11 @@ pub fn run(mut session: Session, opts: &FrontendOptions) -> rustyline::Result<()
         files: FilenameCompleter::new(),
         program: String::new(),
     }));
-    let history = if opts.no_history { None } else { history_path() };
+    let history = if opts.no_history {
+        None
+    } else {
+        history_path()
+    };
     if let Some(path) = &history
         && let Err(e) = editor.load_history(path)
         && path.exists()
@@ -102,7 +115,11 @@ pub fn run(mut session: Session, opts: &FrontendOptions) -> rustyline::Result<()
     let mut history_warned = false;
     let mut buffer = String::new();
     loop {
-        let prompt = if buffer.is_empty() { "mprog> " } else { "  ...> " };
+        let prompt = if buffer.is_empty() {
+            "mprog> "
+        } else {
+            "  ...> "
+        };
         match editor.readline(prompt) {
             Ok(line) => {
                 if !buffer.is_empty() {
@@ -147,7 +164,10 @@ pub fn run(mut session: Session, opts: &FrontendOptions) -> rustyline::Result<()
     Ok(())
 }
 
-fn save_history(editor: &mut Editor<ReplHelper, DefaultHistory>, path: &std::path::Path) -> Result<(), String> {
+fn save_history(
+    editor: &mut Editor<ReplHelper, DefaultHistory>,
+    path: &std::path::Path,
+) -> Result<(), String> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
     }

@@ -80,7 +80,8 @@ fn ends_with_operator(code: &str) -> bool {
         .rev()
         .collect();
     let before = &code[..code.len() - last_word.len()];
-    let standalone = before.is_empty() || before.ends_with(|c: char| !c.is_ascii_alphanumeric() && c != '_' && c != '.');
+    let standalone = before.is_empty()
+        || before.ends_with(|c: char| !c.is_ascii_alphanumeric() && c != '_' && c != '.');
     standalone && TRAILING_WORDS.contains(&last_word.to_ascii_lowercase().as_str())
 }
 
@@ -99,10 +100,25 @@ mod tests {
 
     #[test]
     fn trailing_operators_continue() {
-        for s in ["head.y >", "a +", "x and", "x or", "p ==", "let a =", "during 1s..", "x <="] {
+        for s in [
+            "head.y >",
+            "a +",
+            "x and",
+            "x or",
+            "p ==",
+            "let a =",
+            "during 1s..",
+            "x <=",
+        ] {
             assert!(needs_more(s), "{s}");
         }
-        for s in ["head.y > 1", "head.y > 1 m", "band", "l_hand.x", "minimize speed(pelvis)"] {
+        for s in [
+            "head.y > 1",
+            "head.y > 1 m",
+            "band",
+            "l_hand.x",
+            "minimize speed(pelvis)",
+        ] {
             assert!(!needs_more(s), "{s}");
         }
     }

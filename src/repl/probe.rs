@@ -53,7 +53,9 @@ pub fn compile_probe(session: &Session, text: &str) -> Result<Probe, Reply> {
     };
     let as_statement = match attempt(text.to_string(), Kind::Statement) {
         Ok(p) if p.cols.is_empty() => {
-            return Err(Reply::error("nothing to evaluate: the input has no constraint or value"));
+            return Err(Reply::error(
+                "nothing to evaluate: the input has no constraint or value",
+            ));
         }
         Ok(p) => return Ok(p),
         Err(d) => d,
@@ -64,14 +66,22 @@ pub fn compile_probe(session: &Session, text: &str) -> Result<Probe, Reply> {
         .filter(|i| i.severity == crate::lang::Severity::Error)
         .all(|i| i.code == "mprog::not_a_constraint");
     if !real_errors(&as_statement) {
-        return Err(Reply::error("nothing to evaluate: the input has no constraint or value"));
+        return Err(Reply::error(
+            "nothing to evaluate: the input has no constraint or value",
+        ));
     }
     if !only_not_constraint {
-        return Err(Reply::diagnostics(visible(without_not_constraint(as_statement))));
+        return Err(Reply::diagnostics(visible(without_not_constraint(
+            as_statement,
+        ))));
     }
     match attempt(format!("minimize ({text})"), Kind::Scalar) {
         Ok(p) => Ok(p),
-        Err(d) if d.items.iter().any(|i| i.code == "mprog::type_mismatch" && i.message.contains("vector")) => {
+        Err(d)
+            if d.items
+                .iter()
+                .any(|i| i.code == "mprog::type_mismatch" && i.message.contains("vector")) =>
+        {
             let code = ["x", "y", "z"]
                 .map(|c| format!("minimize ({text}).{c}"))
                 .join("\n");
@@ -89,12 +99,20 @@ fn without_not_constraint(d: Diagnostics) -> Diagnostics {
     if !others {
         return d;
     }
-    let items = d.items.into_iter().filter(|i| i.code != "mprog::not_a_constraint").collect();
+    let items = d
+        .items
+        .into_iter()
+        .filter(|i| i.code != "mprog::not_a_constraint")
+        .collect();
     Diagnostics::new(&d.name, d.source, items)
 }
 
 /// The motion as `[1, people, frames, 22, 3]` for a program of `people` people.
-pub fn joints_tensor(m: &CurrentMotion, people: usize, device: &Device) -> Result<Tensor<5>, String> {
+pub fn joints_tensor(
+    m: &CurrentMotion,
+    people: usize,
+    device: &Device,
+) -> Result<Tensor<5>, String> {
     if m.people.len() != people {
         return Err(format!(
             "the program describes {people} person(s) but the motion ({}) has {}; {}",
@@ -114,9 +132,16 @@ pub fn joints_tensor(m: &CurrentMotion, people: usize, device: &Device) -> Resul
     let data: Vec<f32> = m
         .people
         .iter()
-        .flat_map(|p| p.frames[..frames].iter().flat_map(|pose| pose.iter().flat_map(|v| v.to_array())))
+        .flat_map(|p| {
+            p.frames[..frames]
+                .iter()
+                .flat_map(|pose| pose.iter().flat_map(|v| v.to_array()))
+        })
         .collect();
-    Ok(Tensor::from_data(TensorData::new(data, [1, people, frames, NUM_JOINTS, 3]), device))
+    Ok(Tensor::from_data(
+        TensorData::new(data, [1, people, frames, NUM_JOINTS, 3]),
+        device,
+    ))
 }
 
 /// `:eval`.
@@ -191,7 +216,11 @@ fn as_frame_errors(merged: &[Option<f32>]) -> FrameErrors {
 
 /// `min mean max` and a sparkline (or the value at the one frame).
 fn series_lines(label: &str, fe: &FrameErrors, frames: usize) -> Vec<String> {
-    let pad = if label.is_empty() { String::new() } else { format!("{label}  ") };
+    let pad = if label.is_empty() {
+        String::new()
+    } else {
+        format!("{label}  ")
+    };
     let blank = " ".repeat(pad.chars().count());
     let mut full = vec![None; frames];
     for (i, &t) in fe.frames.iter().enumerate() {
@@ -199,7 +228,11 @@ fn series_lines(label: &str, fe: &FrameErrors, frames: usize) -> Vec<String> {
             full[t] = Some(fe.errors[0][i]);
         }
     }
-    let present: Vec<(usize, f32)> = full.iter().enumerate().filter_map(|(t, v)| v.map(|v| (t, v))).collect();
+    let present: Vec<(usize, f32)> = full
+        .iter()
+        .enumerate()
+        .filter_map(|(t, v)| v.map(|v| (t, v)))
+        .collect();
     match present.as_slice() {
         [] => vec![format!("  {pad}applies at no frame of this motion")],
         [(t, v)] => vec![format!("  {pad}frame {t}: {}", num(*v))],
@@ -210,8 +243,16 @@ fn series_lines(label: &str, fe: &FrameErrors, frames: usize) -> Vec<String> {
             let last = present[present.len() - 1].0;
             let span = &full[first..=last];
             vec![
-                format!("  {pad}min {}  mean {}  max {}", num(lo), num(mean), num(hi)),
-                format!("  {blank}{}  frames {first}–{last}", sparkline(span, SPARK_WIDTH)),
+                format!(
+                    "  {pad}min {}  mean {}  max {}",
+                    num(lo),
+                    num(mean),
+                    num(hi)
+                ),
+                format!(
+                    "  {blank}{}  frames {first}–{last}",
+                    sparkline(span, SPARK_WIDTH)
+                ),
             ]
         }
     }
@@ -224,7 +265,9 @@ pub fn grad(session: &Session, text: &str) -> Reply {
     };
     let probe = match compile_probe(session, text) {
         Ok(p) if p.kind == Kind::Vector => {
-            return Reply::error("`:grad` needs a constraint or a scalar; a vector has no single gradient (try `norm(…)` or `.y`)");
+            return Reply::error(
+                "`:grad` needs a constraint or a scalar; a vector has no single gradient (try `norm(…)` or `.y`)",
+            );
         }
         Ok(p) => p,
         Err(r) => return r,
@@ -241,18 +284,40 @@ pub fn grad(session: &Session, text: &str) -> Reply {
     };
     let cols = probe.cols.clone();
     let picked = ev.per_statement.narrow(1, cols.start, cols.len());
-    let value = host(picked.clone().sum_dim(1)).first().copied().unwrap_or(f32::NAN);
+    let value = host(picked.clone().sum_dim(1))
+        .first()
+        .copied()
+        .unwrap_or(f32::NAN);
     let grads = picked.sum().backward();
     let Some(g) = x.grad(&grads) else {
-        return Reply::text(format!("{}: the error does not depend on the motion", text.trim()));
+        return Reply::text(format!(
+            "{}: the error does not depend on the motion",
+            text.trim()
+        ));
     };
     let g = host5(g);
     let unit = probe.program.statements()[cols.start].unit.clone();
     let shown = text.split_whitespace().collect::<Vec<_>>().join(" ");
-    Reply::text(grad_table(&shown, &g, people, m.frames(), value, &unit, &probe.program))
+    Reply::text(grad_table(
+        &shown,
+        &g,
+        people,
+        m.frames(),
+        value,
+        &unit,
+        &probe.program,
+    ))
 }
 
-fn grad_table(text: &str, g: &[f32], people: usize, frames: usize, value: f32, unit: &str, p: &Program) -> String {
+fn grad_table(
+    text: &str,
+    g: &[f32],
+    people: usize,
+    frames: usize,
+    value: f32,
+    unit: &str,
+    p: &Program,
+) -> String {
     // [people, frames, 22, 3] → per (person, joint): L2 norm over frames and xyz, peak frame.
     let mut rows: Vec<(usize, usize, f32, usize)> = Vec::new();
     for person in 0..people {
@@ -277,14 +342,20 @@ fn grad_table(text: &str, g: &[f32], people: usize, frames: usize, value: f32, u
         num(value),
         num(total)
     )];
-    if !(total > 0.0) {
-        out.push("  the gradient is zero: this constraint is satisfied (or flat) on this motion".into());
+    if total.is_nan() || total <= 0.0 {
+        out.push(
+            "  the gradient is zero: this constraint is satisfied (or flat) on this motion".into(),
+        );
         return out.join("\n");
     }
     let max = rows[0].2;
     let moving = rows.iter().filter(|r| r.2 > 1e-6 * max).count();
     for &(person, j, mag, peak) in rows.iter().take(8).filter(|r| r.2 > 1e-6 * max) {
-        let who = if people > 1 { format!("{}.", p.people()[person].name) } else { String::new() };
+        let who = if people > 1 {
+            format!("{}.", p.people()[person].name)
+        } else {
+            String::new()
+        };
         out.push(format!(
             "  {:18} {:>10}  {:<16} peak at frame {peak}",
             format!("{who}{}", JOINT_NAMES[j]),
@@ -293,7 +364,10 @@ fn grad_table(text: &str, g: &[f32], people: usize, frames: usize, value: f32, u
         ));
     }
     if moving > 8 {
-        out.push(format!("  … {} more joints with a smaller gradient", moving - 8));
+        out.push(format!(
+            "  … {} more joints with a smaller gradient",
+            moving - 8
+        ));
     }
     out.join("\n")
 }
@@ -323,7 +397,10 @@ pub fn score_new(session: &Session, start: usize, reply: &mut Reply) {
         return;
     };
     let infos = program.statements();
-    let first = infos.iter().position(|s| s.span.start >= start).unwrap_or(infos.len());
+    let first = infos
+        .iter()
+        .position(|s| s.span.start >= start)
+        .unwrap_or(infos.len());
     if first == infos.len() {
         return;
     }
@@ -346,18 +423,35 @@ fn score_lines(
     let per = host(ev.per_statement);
     let infos = program.statements();
     let f = m.frames();
-    let width = infos[cols.clone()].iter().map(|s| s.label.chars().count()).max().unwrap_or(0).min(48);
+    let width = infos[cols.clone()]
+        .iter()
+        .map(|s| s.label.chars().count())
+        .max()
+        .unwrap_or(0)
+        .min(48);
     let mut out = Vec::new();
     for i in cols.clone() {
         let s = &infos[i];
         let label: String = s.label.chars().take(48).collect();
-        let weight = if s.weight == 1.0 { String::new() } else { format!(" ×{}", s.weight) };
+        let weight = if s.weight == 1.0 {
+            String::new()
+        } else {
+            format!(" ×{}", s.weight)
+        };
         let spark = sparkline(&merge(std::slice::from_ref(&frames[i]), f), 24);
-        out.push(format!("  {label:width$}  {:>9} {:<5}{weight}  {spark}", num(per[i]), s.unit));
+        out.push(format!(
+            "  {label:width$}  {:>9} {:<5}{weight}  {spark}",
+            num(per[i]),
+            s.unit
+        ));
     }
     if with_total {
         let total: f32 = per.iter().sum();
-        out.push(format!("  total {} on {} ({f} frames)", num(total), m.origin));
+        out.push(format!(
+            "  total {} on {} ({f} frames)",
+            num(total),
+            m.origin
+        ));
     }
     Ok(out.join("\n"))
 }

@@ -122,7 +122,13 @@ impl Session {
     pub fn set_motion(&mut self, people: Vec<Motion>, origin: impl Into<String>) {
         let people = people
             .into_iter()
-            .map(|m| if (m.fps - FPS).abs() > 1e-3 { m.resample(FPS) } else { m })
+            .map(|m| {
+                if (m.fps - FPS).abs() > 1e-3 {
+                    m.resample(FPS)
+                } else {
+                    m
+                }
+            })
             .collect();
         self.motion = Some(CurrentMotion {
             people,
@@ -190,16 +196,24 @@ impl Session {
         let diags = crate::lang::check_source(&text, &name, &[]);
         if diags.has_errors() {
             let mut r = Reply::diagnostics(diags);
-            r.push(Item::Error(format!("{name} not loaded; the session's program is unchanged")));
+            r.push(Item::Error(format!(
+                "{name} not loaded; the session's program is unchanged"
+            )));
             return r;
         }
-        self.program = if text.ends_with('\n') { text } else { format!("{text}\n") };
+        self.program = if text.ends_with('\n') {
+            text
+        } else {
+            format!("{text}\n")
+        };
         let mut reply = Reply::default();
         if diags.warnings().next().is_some() {
             reply.push(Item::Diagnostics(diags));
         }
         let lines = self.program.lines().count();
-        reply.push(Item::Text(format!("loaded {name} ({lines} lines); `:show` prints it, `:score` scores it")));
+        reply.push(Item::Text(format!(
+            "loaded {name} ({lines} lines); `:show` prints it, `:score` scores it"
+        )));
         reply
     }
 
@@ -207,10 +221,16 @@ impl Session {
         let name = path.display().to_string();
         let people = match read_motion(path) {
             Err(e) => return Reply::error(e.to_string()),
-            Ok(LoadedMotion::Joints { people, .. }) => people.into_iter().map(|p| p.motion).collect(),
+            Ok(LoadedMotion::Joints { people, .. }) => {
+                people.into_iter().map(|p| p.motion).collect()
+            }
             Ok(LoadedMotion::Features(array)) => match recover_from_ric(&array.data) {
                 Ok(m) => vec![m],
-                Err(e) => return Reply::error(format!("{name}: recovering joints from HumanML3D features: {e}")),
+                Err(e) => {
+                    return Reply::error(format!(
+                        "{name}: recovering joints from HumanML3D features: {e}"
+                    ));
+                }
             },
         };
         self.set_motion(people, name);
@@ -235,10 +255,16 @@ impl Session {
             Err(e) => Reply::error(format!("generation failed: {e}")),
             Ok(g) => {
                 let unknown = g.unknown_words.first().cloned().unwrap_or_default();
-                self.set_motion(g.motions, format!("gen \"{prompt}\" {seconds}s seed {seed}"));
+                self.set_motion(
+                    g.motions,
+                    format!("gen \"{prompt}\" {seconds}s seed {seed}"),
+                );
                 let mut r = Reply::text(self.describe_motion());
                 if !unknown.is_empty() {
-                    r.push(Item::Warning(format!("the model does not know: {}", unknown.join(", "))));
+                    r.push(Item::Warning(format!(
+                        "the model does not know: {}",
+                        unknown.join(", ")
+                    )));
                 }
                 r
             }
@@ -291,7 +317,8 @@ impl Session {
 }
 
 /// Message when a command needs a motion.
-pub const NO_MOTION: &str = "no current motion: `:motion FILE` loads one, `:gen \"PROMPT\"` generates one";
+pub const NO_MOTION: &str =
+    "no current motion: `:motion FILE` loads one, `:gen \"PROMPT\"` generates one";
 
 /// Drops the diagnostics the REPL keeps quiet about.
 pub fn visible(d: Diagnostics) -> Diagnostics {
@@ -313,7 +340,13 @@ pub fn real_errors(d: &Diagnostics) -> bool {
 fn help(topic: Option<&str>) -> Reply {
     if let Some(t) = topic {
         return match command::find(t) {
-            Some(c) => Reply::text(format!(":{} {}\n    {}{}", c.name, c.args, c.help, aliases(c))),
+            Some(c) => Reply::text(format!(
+                ":{} {}\n    {}{}",
+                c.name,
+                c.args,
+                c.help,
+                aliases(c)
+            )),
             None => Reply::error(format!("no command `:{t}`")),
         };
     }
@@ -325,7 +358,9 @@ fn help(topic: Option<&str>) -> Reply {
         let head = format!(":{} {}", c.name, c.args);
         s.push_str(&format!("  {head:34} {}{}\n", c.help, aliases(c)));
     }
-    s.push_str("Tab completes joints, functions, keywords and commands; history is kept between sessions.");
+    s.push_str(
+        "Tab completes joints, functions, keywords and commands; history is kept between sessions.",
+    );
     Reply::text(s)
 }
 
@@ -335,7 +370,11 @@ fn aliases(c: &command::CommandDoc) -> String {
     } else {
         format!(
             " (also {})",
-            c.aliases.iter().map(|a| format!(":{a}")).collect::<Vec<_>>().join(", ")
+            c.aliases
+                .iter()
+                .map(|a| format!(":{a}"))
+                .collect::<Vec<_>>()
+                .join(", ")
         )
     }
 }

@@ -29,7 +29,12 @@ pub fn sparkline(values: &[Option<f32>], width: usize) -> String {
         .map(|b| {
             let lo = b * values.len() / buckets;
             let hi = ((b + 1) * values.len() / buckets).max(lo + 1);
-            let vals: Vec<f32> = values[lo..hi].iter().flatten().copied().filter(|v| v.is_finite()).collect();
+            let vals: Vec<f32> = values[lo..hi]
+                .iter()
+                .flatten()
+                .copied()
+                .filter(|v| v.is_finite())
+                .collect();
             (!vals.is_empty()).then(|| vals.iter().sum::<f32>() / vals.len() as f32)
         })
         .collect();
@@ -51,7 +56,7 @@ pub fn sparkline(values: &[Option<f32>], width: usize) -> String {
 
 /// A bar of `value / max` of `width` eighth-blocks.
 pub fn bar(value: f32, max: f32, width: usize) -> String {
-    if !(max > 0.0) || !value.is_finite() {
+    if max.is_nan() || max <= 0.0 || !value.is_finite() {
         return String::new();
     }
     let eighths = ((value / max).clamp(0.0, 1.0) * (width * 8) as f32).round() as usize;
