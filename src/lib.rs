@@ -10,6 +10,7 @@
 //! | model | [`model`] | features + text → denoiser, samplers, training |
 //! | language | [`lang`] | source → AST → checked IR → burn error graph |
 //! | pictures | [`render`] | motions, curves → GIF / PNG |
+//! | viewer | [`view`] | motions + program geometry → one self-contained HTML page |
 //!
 //! Conventions everywhere: HumanML3D 22-joint skeleton ([`skeleton`]), metres, Y up,
 //! 20 fps; tensors of joint positions are `[batch, people, frames, 22, 3]`.
@@ -23,3 +24,4 @@ pub mod model;
 pub mod motion;
 pub mod render;
 pub mod skeleton;
+pub mod view;

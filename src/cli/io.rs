@@ -1,9 +1,11 @@
 //! Reading and writing motions for the subcommands: any motion file in, any list of
-//! outputs out (`.npy`, `.json`, `.bvh` data; `.gif`, `.png` pictures).
+//! outputs out (`.npy` with its `.meta.json` sidecar, `.json`, `.bvh` data; `.gif`, `.png`
+//! pictures; `.html` viewer pages).
 
+use super::export::ExportArgs;
 use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::features::recover_from_ric;
-use mprog::formats::{LoadedMotion, Meta, read_motion, write_motion};
+use mprog::formats::{LoadedMotion, Meta, read_motion, write_motion_with, write_sidecar_meta};
 use mprog::motion::Motion;
 use mprog::render::{RenderOptions, render_to_path};
 use std::path::{Path, PathBuf};
@@ -12,28 +14,75 @@ use std::path::{Path, PathBuf};
 pub fn load_people(path: &Path) -> Result<(Vec<Motion>, Meta)> {
     let loaded = read_motion(path).into_diagnostic()?;
     Ok(match loaded {
-        LoadedMotion::Joints { people, meta } => (people.into_iter().map(|p| p.motion).collect(), meta),
+        LoadedMotion::Joints { people, meta } => {
+            (people.into_iter().map(|p| p.motion).collect(), meta)
+        }
         LoadedMotion::Features(array) => {
             let motion = recover_from_ric(&array.data)
                 .into_diagnostic()
-                .wrap_err_with(|| format!("{}: recovering joints from HumanML3D features", path.display()))?;
+                .wrap_err_with(|| {
+                    format!(
+                        "{}: recovering joints from HumanML3D features",
+                        path.display()
+                    )
+                })?;
             (vec![motion], Meta::new())
         }
     })
 }
 
-/// Writes every requested output; pictures get `title`.
-pub fn write_outputs(outputs: &[PathBuf], people: &[Motion], meta: &Meta, title: &str) -> Result<()> {
+/// Writes every requested output with default export settings; pictures get `title`.
+pub fn write_outputs(
+    outputs: &[PathBuf],
+    people: &[Motion],
+    meta: &Meta,
+    title: &str,
+) -> Result<()> {
+    write_outputs_with(outputs, people, meta, title, &ExportArgs::default())
+}
+
+/// Writes every requested output; pictures and pages get `title`, BVH files `export`'s
+/// settings, and every `.npy` a `<name>.meta.json` sidecar holding `meta` (plus `fps`).
+pub fn write_outputs_with(
+    outputs: &[PathBuf],
+    people: &[Motion],
+    meta: &Meta,
+    title: &str,
+    export: &ExportArgs,
+) -> Result<()> {
+    export.check_against(outputs)?;
     for out in outputs {
-        let ext = out.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+        let ext = out
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
         match ext.as_str() {
-            "gif" | "png" => render_to_path(people, &RenderOptions::titled(title), out)
+            "gif" | "png" => {
+                let mut opts = RenderOptions::titled(title);
+                opts.overlays = mprog::view::overlays_from_meta(meta).into_diagnostic()?;
+                render_to_path(people, &opts, out)
+                    .into_diagnostic()
+                    .wrap_err_with(|| format!("rendering {}", out.display()))?
+            }
+            "html" | "htm" => mprog::view::write_html(people, meta, title, out)
                 .into_diagnostic()
-                .wrap_err_with(|| format!("rendering {}", out.display()))?,
-            "npy" | "json" | "bvh" => write_motion(out, people, meta).into_diagnostic()?,
+                .wrap_err_with(|| format!("writing the viewer {}", out.display()))?,
+            "npy" => {
+                write_motion_with(out, people, meta, &export.bvh_options()).into_diagnostic()?;
+                let mut side = meta.clone();
+                if let Some(m) = people.first() {
+                    side.entry("fps").or_insert(m.fps.into());
+                }
+                let path = write_sidecar_meta(out, &side).into_diagnostic()?;
+                eprintln!("wrote {} (+ {})", out.display(), path.display());
+                continue;
+            }
+            "json" | "bvh" => {
+                write_motion_with(out, people, meta, &export.bvh_options()).into_diagnostic()?
+            }
             _ => {
                 return Err(miette!(
-                    help = "use .bvh, .npy, .json, .gif or .png",
+                    help = "use .bvh, .npy, .json, .gif, .png or .html",
                     "cannot write {}: unknown extension",
                     out.display()
                 ));
@@ -53,8 +102,14 @@ pub fn numbered(outputs: &[PathBuf], i: usize, count: usize) -> Vec<PathBuf> {
     outputs
         .iter()
         .map(|p| {
-            let stem = p.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
-            let ext = p.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+            let stem = p
+                .file_stem()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_default();
+            let ext = p
+                .extension()
+                .map(|e| format!(".{}", e.to_string_lossy()))
+                .unwrap_or_default();
             p.with_file_name(format!("{stem}_{i}{ext}"))
         })
         .collect()

@@ -4,4 +4,6 @@ pub mod bench;
 pub mod data;
 pub mod train;
 pub mod convert;
+pub mod export;
 pub mod io;
+pub mod view;

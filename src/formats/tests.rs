@@ -298,12 +298,13 @@ fn json_centimetres_and_other_rates_are_converted() {
 }
 
 #[test]
-fn dispatch_refuses_unknown_extensions_and_bvh_output() {
+fn dispatch_refuses_unknown_extensions_and_several_people_in_one_bvh() {
     let dir = tempfile::tempdir().unwrap();
-    let m = [sample_motion(2, 0.0)];
+    let m = [sample_motion(2, 0.0), sample_motion(2, 1.0)];
     let e = write_motion(&dir.path().join("x.bvh"), &m, &Meta::new()).unwrap_err();
     assert!(
-        e.to_string().contains("BVH export is not implemented yet"),
+        e.to_string()
+            .contains("holds one skeleton but there are 2 people"),
         "{e}"
     );
     let e = write_motion(&dir.path().join("x.csv"), &m, &Meta::new()).unwrap_err();
@@ -313,6 +314,29 @@ fn dispatch_refuses_unknown_extensions_and_bvh_output() {
     let e = read_motion(&dir.path().join("missing.npy")).unwrap_err();
     assert!(e.to_string().contains("missing.npy: cannot read"), "{e}");
     assert!(!dir.path().join("x.bvh").exists());
+}
+
+/// mprog reads its own BVH back: the header comment is skipped, the joints map by their
+/// HumanML3D names (not through the zero-offset connectors), positions within 1 mm.
+#[test]
+fn own_bvh_export_reads_back_through_read_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("walk.bvh");
+    let walk = crate::render::test_motion::walk(30, 1.2, Vec3::new(0.5, 0.0, -1.0), Vec3::X);
+    write_motion(&path, std::slice::from_ref(&walk), &Meta::new()).unwrap();
+    let LoadedMotion::Joints { people, meta } = read_motion(&path).unwrap() else {
+        panic!("joints expected")
+    };
+    assert_eq!(meta["rig"], "humanml3d");
+    assert_eq!(meta["warnings"], serde_json::json!([]));
+    let back = &people[0].motion;
+    assert_eq!(back.len(), walk.len());
+    for (f, (a, b)) in back.frames.iter().zip(&walk.frames).enumerate() {
+        for j in 0..NUM_JOINTS {
+            let err = (a[j] - b[j]).length();
+            assert!(err < 1e-3, "frame {f} joint {j}: {err} m");
+        }
+    }
 }
 
 #[test]
