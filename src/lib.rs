@@ -12,6 +12,7 @@
 //! | solvers | [`solve`] | error graph + prompts → guided / optimised motions |
 //! | pictures | [`render`] | motions, curves → GIF / PNG |
 //! | interfaces | [`repl`], [`docgen`] | interactive sessions; LLM prompt card, book pages |
+//! | viewer | [`view`] | motions + program geometry → one self-contained HTML page |
 //!
 //! Conventions everywhere: HumanML3D 22-joint skeleton ([`skeleton`]), metres, Y up,
 //! 20 fps; tensors of joint positions are `[batch, people, frames, 22, 3]`.
@@ -30,3 +31,4 @@ pub mod render;
 pub mod repl;
 pub mod skeleton;
 pub mod solve;
+pub mod view;

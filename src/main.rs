@@ -22,6 +22,9 @@ enum Command {
     Convert(cli::convert::ConvertArgs),
     /// Render a motion file as an animated GIF or a PNG strip.
     Render(cli::convert::RenderArgs),
+    /// Write a self-contained HTML page that plays a motion in 3-D (overlays, contacts and
+    /// per-statement error charts from the file's meta).
+    View(cli::view::ViewArgs),
     /// Build a training set from BVH files.
     #[command(subcommand)]
     Data(cli::data::DataCommand),
@@ -56,6 +59,7 @@ fn main() -> miette::Result<()> {
         Command::Data(cmd) => cli::data::run(cmd)?,
         Command::Convert(args) => cli::convert::convert(args)?,
         Command::Render(args) => cli::convert::render(args)?,
+        Command::View(args) => cli::view::run(args)?,
         Command::Train(args) => cli::train::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
         Command::Score(args) => cli::score::run(args)?,

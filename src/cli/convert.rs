@@ -1,6 +1,7 @@
 //! `mprog convert` and `mprog render`: motion files between formats, and pictures of them.
 
-use super::io::{load_people, write_outputs};
+use super::export::ExportArgs;
+use super::io::{load_people, write_outputs, write_outputs_with};
 use miette::Result;
 use std::path::PathBuf;
 
@@ -9,9 +10,11 @@ use std::path::PathBuf;
 pub struct ConvertArgs {
     /// Input motion: .bvh, .npy (N×22×3 joints or N×263 HumanML3D features) or .json.
     input: PathBuf,
-    /// Outputs, by extension: .bvh, .npy, .json, .gif, .png.
+    /// Outputs, by extension: .bvh, .npy (+ .meta.json sidecar), .json, .gif, .png, .html.
     #[arg(short, long, num_args = 1.., required = true)]
     out: Vec<PathBuf>,
+    #[command(flatten)]
+    export: ExportArgs,
 }
 
 /// Arguments of `mprog render`.
@@ -19,7 +22,7 @@ pub struct ConvertArgs {
 pub struct RenderArgs {
     /// Input motion: .bvh, .npy or .json.
     input: PathBuf,
-    /// Picture: .gif (animation) or .png (strip of frames).
+    /// Picture: .gif (animation), .png (strip of frames) or .html (interactive viewer).
     #[arg(short, long, num_args = 1.., required = true)]
     out: Vec<PathBuf>,
     /// Title drawn above the picture (default: the file name).
@@ -31,7 +34,7 @@ pub struct RenderArgs {
 pub fn convert(args: ConvertArgs) -> Result<()> {
     let (people, meta) = load_people(&args.input)?;
     let title = args.input.display().to_string();
-    write_outputs(&args.out, &people, &meta, &title)
+    write_outputs_with(&args.out, &people, &meta, &title, &args.export)
 }
 
 /// Runs `mprog render`.

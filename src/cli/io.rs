@@ -1,9 +1,11 @@
 //! Reading and writing motions for the subcommands: any motion file in, any list of
-//! outputs out (`.npy`, `.json`, `.bvh` data; `.gif`, `.png` pictures).
+//! outputs out (`.npy` with its `.meta.json` sidecar, `.json`, `.bvh` data; `.gif`, `.png`
+//! pictures; `.html` viewer pages).
 
+use super::export::ExportArgs;
 use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::features::recover_from_ric;
-use mprog::formats::{LoadedMotion, Meta, read_motion, write_motion};
+use mprog::formats::{LoadedMotion, Meta, read_motion, write_motion_with, write_sidecar_meta};
 use mprog::motion::Motion;
 use mprog::render::{RenderOptions, render_to_path};
 use std::path::{Path, PathBuf};
@@ -29,21 +31,63 @@ pub fn load_people(path: &Path) -> Result<(Vec<Motion>, Meta)> {
     })
 }
 
-/// Writes every requested output; pictures get `title`. Every output is checked before
-/// the first is written, so a bad one leaves none behind.
+/// Writes every requested output with default export settings; pictures get `title`.
 pub fn write_outputs(
     outputs: &[PathBuf],
     people: &[Motion],
     meta: &Meta,
     title: &str,
 ) -> Result<()> {
+    write_outputs_with(outputs, people, meta, title, &ExportArgs::default())
+}
+
+/// Writes every requested output; pictures and pages get `title`, BVH files `export`'s
+/// settings, and every `.npy` a `<name>.meta.json` sidecar holding `meta` (plus `fps`).
+pub fn write_outputs_with(
+    outputs: &[PathBuf],
+    people: &[Motion],
+    meta: &Meta,
+    title: &str,
+    export: &ExportArgs,
+) -> Result<()> {
+    export.check_against(outputs)?;
     check_outputs(outputs, people.len())?;
     for out in outputs {
-        match extension(out).as_str() {
-            "gif" | "png" => render_to_path(people, &RenderOptions::titled(title), out)
+        let ext = out
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "gif" | "png" => {
+                let mut opts = RenderOptions::titled(title);
+                opts.overlays = mprog::view::overlays_from_meta(meta).into_diagnostic()?;
+                render_to_path(people, &opts, out)
+                    .into_diagnostic()
+                    .wrap_err_with(|| format!("rendering {}", out.display()))?
+            }
+            "html" | "htm" => mprog::view::write_html(people, meta, title, out)
                 .into_diagnostic()
-                .wrap_err_with(|| format!("rendering {}", out.display()))?,
-            _ => write_motion(out, people, meta).into_diagnostic()?,
+                .wrap_err_with(|| format!("writing the viewer {}", out.display()))?,
+            "npy" => {
+                write_motion_with(out, people, meta, &export.bvh_options()).into_diagnostic()?;
+                let mut side = meta.clone();
+                if let Some(m) = people.first() {
+                    side.entry("fps").or_insert(m.fps.into());
+                }
+                let path = write_sidecar_meta(out, &side).into_diagnostic()?;
+                eprintln!("wrote {} (+ {})", out.display(), path.display());
+                continue;
+            }
+            "json" | "bvh" => {
+                write_motion_with(out, people, meta, &export.bvh_options()).into_diagnostic()?
+            }
+            _ => {
+                return Err(miette!(
+                    help = "use .bvh, .npy, .json, .gif, .png or .html",
+                    "cannot write {}: unknown extension",
+                    out.display()
+                ));
+            }
         }
         eprintln!("wrote {}", out.display());
     }
@@ -63,7 +107,7 @@ pub fn check_outputs(outputs: &[PathBuf], people: usize) -> Result<()> {
 
 fn check_output(out: &Path, people: usize) -> Result<()> {
     match extension(out).as_str() {
-        "gif" | "png" | "npy" | "json" => Ok(()),
+        "gif" | "png" | "npy" | "json" | "html" | "htm" => Ok(()),
         "bvh" if people == 1 => Ok(()),
         "bvh" => Err(miette!(
             help = "write one .bvh per person, or use .json / .npy",
@@ -71,7 +115,7 @@ fn check_output(out: &Path, people: usize) -> Result<()> {
             out.display()
         )),
         _ => Err(miette!(
-            help = "use .bvh, .npy, .json, .gif or .png",
+            help = "use .bvh, .npy, .json, .gif, .png or .html",
             "cannot write {}: unknown extension",
             out.display()
         )),

@@ -162,20 +162,23 @@ pub fn run(args: RunArgs) -> Result<()> {
     write_outputs(&args.out, people, &meta, &format!("{} ({})", program.name(), solver.name()))
 }
 
-/// `[{label, line, unit, frames, values}]` for the viewer's timeline.
+/// `[{label, line, unit, values}]` for the viewer's timeline (`meta.statement_errors`):
+/// one value per frame of the motion, null where the statement does not apply.
 fn statement_errors(program: &Program, people: &[Motion], device: &Device) -> Result<serde_json::Value> {
+    let total = people.iter().map(Motion::len).min().unwrap_or(0);
     let frames = program.evaluate_frames(sample_tensor(people, device)).into_diagnostic()?;
     let list: Vec<serde_json::Value> = program
         .statements()
         .iter()
         .zip(frames)
         .map(|(s, f)| {
-            let values: Vec<Option<f32>> = f.errors[0]
-                .iter()
-                .zip(&f.applies[0])
-                .map(|(v, a)| a.then_some(*v))
-                .collect();
-            serde_json::json!({"label": s.label, "line": s.line, "unit": s.unit, "frames": f.frames, "values": values})
+            let mut values: Vec<Option<f32>> = vec![None; total];
+            for ((&t, v), a) in f.frames.iter().zip(&f.errors[0]).zip(&f.applies[0]) {
+                if *a && t < total {
+                    values[t] = Some(*v);
+                }
+            }
+            serde_json::json!({"label": s.label, "line": s.line, "unit": s.unit, "values": values})
         })
         .collect();
     Ok(serde_json::Value::Array(list))

@@ -13,7 +13,10 @@
 //! * Channels: the root has `Xposition Yposition Zposition Zrotation Yrotation Xrotation`,
 //!   every other joint `Zrotation Yrotation Xrotation` (local rotation = Rz·Ry·Rx, degrees).
 //!   The root OFFSET is zero: its position channels are absolute.
-//! * Frame time = 1/fps. Units metres (or centimetres), axes Y up (or Blender's Z up:
+//! * Frame time = 1/fps; [`BvhExportOptions::fps`] resamples the joint positions to another
+//!   rate (e.g. 30 or 60 for animation tools) before the rotations are solved, by
+//!   Catmull–Rom interpolation: it follows curved joint paths, so bones keep their length
+//!   (straight-line interpolation shortens a fast forearm by centimetres). Units metres (or centimetres), axes Y up (or Blender's Z up:
 //!   (x, y, z) ↦ (x, −z, y)). A `#` comment after the `HIERARCHY` line states units, axes
 //!   and fps; Blender's importer skips it (it only looks for keywords there).
 
@@ -48,13 +51,19 @@ pub enum BvhAxes {
 }
 
 /// Options of [`write_bvh`] / [`bvh_string`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BvhExportOptions {
     /// Length unit.
     pub units: BvhUnits,
     /// Axis convention.
     pub axes: BvhAxes,
+    /// Frame rate of the file (`None`: the motion's own). Positions are resampled
+    /// (Catmull–Rom) before rotations are solved; the clip keeps its duration.
+    pub fps: Option<f32>,
 }
+
+/// Highest frame rate [`BvhExportOptions::fps`] accepts.
+pub const MAX_EXPORT_FPS: f32 = 1000.0;
 
 /// Errors of the BVH exporter.
 #[derive(Debug, Error)]
@@ -62,6 +71,11 @@ pub enum BvhExportError {
     /// The motion cannot be turned into rotations (empty, non-finite, zero-length bones, …).
     #[error("cannot export this motion as BVH: {0}")]
     Motion(#[from] FeatureError),
+    /// The requested frame rate is not a positive number up to [`MAX_EXPORT_FPS`].
+    #[error(
+        "cannot export at {0} fps: the frame rate must be above 0 and at most {MAX_EXPORT_FPS}"
+    )]
+    BadFps(f32),
     /// Writing the file failed.
     #[error("cannot write the BVH file: {0}")]
     Io(#[from] std::io::Error),
@@ -160,6 +174,18 @@ pub fn bvh_string(m: &Motion, opts: &BvhExportOptions) -> Result<String, BvhExpo
         }
         .into());
     }
+    let source_fps = m.fps;
+    let resampled;
+    let m = match opts.fps {
+        Some(fps) if !(fps.is_finite() && fps > 0.0 && fps <= MAX_EXPORT_FPS) => {
+            return Err(BvhExportError::BadFps(fps));
+        }
+        Some(fps) if fps != m.fps => {
+            resampled = resample_cubic(m, fps);
+            &resampled
+        }
+        _ => m,
+    };
     let poses = ik::poses_f64(m)?;
     let writer = Writer {
         nodes: hierarchy(),
@@ -174,7 +200,7 @@ pub fn bvh_string(m: &Motion, opts: &BvhExportOptions) -> Result<String, BvhExpo
         },
     };
     let mut out = String::new();
-    write_header(&mut out, m, opts);
+    write_header(&mut out, m, source_fps, opts);
     writer.node(&mut out, 0, 0);
     let _ = writeln!(out, "MOTION\nFrames: {}", poses.len());
     let _ = writeln!(out, "Frame Time: {:.8}", 1.0 / m.fps as f64);
@@ -182,6 +208,45 @@ pub fn bvh_string(m: &Motion, opts: &BvhExportOptions) -> Result<String, BvhExpo
         writer.frame(&mut out, pose, t)?;
     }
     Ok(out)
+}
+
+/// `m` at `fps` by Catmull–Rom interpolation of every joint between its neighbouring
+/// frames (the end segments extended in straight lines); frame `i` is at time `i / fps`, the last one at or before
+/// the clip's end, as [`Motion::resample`].
+pub fn resample_cubic(m: &Motion, fps: f32) -> Motion {
+    let n = m.len();
+    if n < 2 || fps == m.fps {
+        return Motion {
+            frames: m.frames.clone(),
+            fps,
+        };
+    }
+    let ratio = f64::from(m.fps) / f64::from(fps);
+    let count = (((n - 1) as f64 / ratio) + 1e-9).floor() as usize + 1;
+    let frames = (0..count)
+        .map(|i| {
+            let src = i as f64 * ratio;
+            let i1 = (src.floor() as usize).min(n - 1);
+            let t = (src - i1 as f64) as f32;
+            let i2 = (i1 + 1).min(n - 1);
+            let f = &m.frames;
+            std::array::from_fn(|j| {
+                let (p1, p2) = (f[i1][j], f[i2][j]);
+                // Past either end, continue the end segment in a straight line.
+                let p0 = if i1 > 0 { f[i1 - 1][j] } else { 2.0 * p1 - p2 };
+                let p3 = if i1 + 2 < n {
+                    f[i1 + 2][j]
+                } else {
+                    2.0 * p2 - p1
+                };
+                0.5 * (2.0 * p1
+                    + (p2 - p0) * t
+                    + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * (t * t)
+                    + (3.0 * p1 - p0 - 3.0 * p2 + p3) * (t * t * t))
+            })
+        })
+        .collect();
+    Motion { frames, fps }
 }
 
 /// Mean length of every bone over the frames (index = child joint).
@@ -195,7 +260,7 @@ fn mean_bone_lengths(poses: &[Pose64]) -> [f64; NUM_JOINTS] {
     len
 }
 
-fn write_header(out: &mut String, m: &Motion, opts: &BvhExportOptions) {
+fn write_header(out: &mut String, m: &Motion, source_fps: f32, opts: &BvhExportOptions) {
     let units = match opts.units {
         BvhUnits::Metres => "metres",
         BvhUnits::Centimetres => "centimetres",
@@ -211,9 +276,14 @@ fn write_header(out: &mut String, m: &Motion, opts: &BvhExportOptions) {
         out,
         "# mprog BVH export: HumanML3D 22-joint skeleton, units {units}, {axes},"
     );
+    let resampled = if m.fps == source_fps {
+        String::new()
+    } else {
+        format!(" (resampled from {source_fps} fps)")
+    };
     let _ = writeln!(
         out,
-        "# {} fps; rotations in degrees, local rotation = Rz * Ry * Rx.",
+        "# {} fps{resampled}; rotations in degrees, local rotation = Rz * Ry * Rx.",
         m.fps
     );
 }
@@ -319,6 +389,27 @@ mod tests {
             }
             assert_eq!(nodes[p].name, JOINT_NAMES[PARENTS[j]], "node {id}");
         }
+    }
+
+    #[test]
+    fn cubic_resampling_keeps_frames_duration_and_straight_lines() {
+        // A joint moving on a straight line at constant speed stays on it, exactly.
+        let frames: Vec<_> = (0..21)
+            .map(|i| [glam::Vec3::new(0.1 * i as f32, 1.0, 0.0); NUM_JOINTS])
+            .collect();
+        let m = Motion { frames, fps: 20.0 };
+        let r = resample_cubic(&m, 30.0);
+        assert_eq!((r.len(), r.fps), (31, 30.0));
+        for (i, pose) in r.frames.iter().enumerate() {
+            let want = 0.1 * i as f32 * 2.0 / 3.0;
+            assert!(
+                (pose[5].x - want).abs() < 1e-5,
+                "frame {i}: {} vs {want}",
+                pose[5].x
+            );
+        }
+        // Every third 30 fps frame is an original frame.
+        assert_eq!(r.frames[3][0], m.frames[2][0]);
     }
 
     #[test]

@@ -3,14 +3,15 @@
 //!
 //! | extension | read | write |
 //! | --- | --- | --- |
-//! | `.bvh` | [`super::bvh::import_bvh`], retargeted to 22 joints, 20 fps | not yet (BVH export is separate work) |
-//! | `.npy` | `[N,22,3]`, `[P,N,22,3]` joints or `[N,263]` features | `[N,22,3]` / `[P,N,22,3]` float32 |
+//! | `.bvh` | [`super::bvh::import_bvh`], retargeted to 22 joints, 20 fps | [`super::bvh_export`], one person, [`BvhExportOptions`] |
+//! | `.npy` | `[N,22,3]`, `[P,N,22,3]` joints or `[N,263]` features; `meta` from the [`super::sidecar`] | `[N,22,3]` / `[P,N,22,3]` float32 |
 //! | `.json` | `mprog-motion` documents | same, with `meta` |
 //!
 //! Motions come back at mprog's 20 fps: BVH is resampled on import, JSON at other
 //! rates is resampled here, `.npy` has no rate and is taken as 20 fps.
 
 use super::bvh::{BvhError, BvhImportOptions, import_bvh};
+use super::bvh_export::BvhExportOptions;
 use super::json::{JsonError, Meta, Person, read_json, write_json};
 use super::npy::{MotionFile, NpyArray, NpyError, read_motion_npy, write_joints_npy};
 use crate::motion::Motion;
@@ -69,7 +70,7 @@ pub fn read_motion(path: &Path) -> Result<LoadedMotion, FormatError> {
         "npy" => Ok(match read_motion_npy(path)? {
             MotionFile::Joints(motions) => LoadedMotion::Joints {
                 people: default_names(motions),
-                meta: Meta::new(),
+                meta: super::sidecar::read_sidecar_meta(path)?.unwrap_or_default(),
             },
             MotionFile::Features(array) => LoadedMotion::Features(array),
         }),
@@ -92,13 +93,24 @@ pub fn read_motion(path: &Path) -> Result<LoadedMotion, FormatError> {
 }
 
 /// Writes motions (one per person) as `.npy`, `.json` or `.bvh` (one person, Y up,
-/// metres); `meta` goes into JSON only, since `.npy` and BVH hold no free-form fields.
+/// metres, the motion's frame rate); `meta` goes into JSON only, since `.npy` and BVH hold
+/// no free-form fields (see [`super::sidecar`] for `.npy`).
 pub fn write_motion(path: &Path, motions: &[Motion], meta: &Meta) -> Result<(), FormatError> {
+    write_motion_with(path, motions, meta, &BvhExportOptions::default())
+}
+
+/// [`write_motion`] with the units, axes and frame rate of a BVH output.
+pub fn write_motion_with(
+    path: &Path,
+    motions: &[Motion],
+    meta: &Meta,
+    bvh: &BvhExportOptions,
+) -> Result<(), FormatError> {
     match extension(path).as_str() {
         "npy" => Ok(write_joints_npy(path, motions)?),
         "json" => Ok(write_json(path, &default_names(motions.to_vec()), meta)?),
         "bvh" => match motions {
-            [one] => super::bvh_export::write_bvh(path, one, &Default::default())
+            [one] => super::bvh_export::write_bvh(path, one, bvh)
                 .map_err(|e| unsupported(path, e.to_string())),
             _ => Err(unsupported(
                 path,

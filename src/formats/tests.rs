@@ -334,6 +334,29 @@ fn dispatch_refuses_unknown_extensions_and_several_people_in_bvh() {
     assert!(!dir.path().join("x.bvh").exists());
 }
 
+/// mprog reads its own BVH back: the header comment is skipped, the joints map by their
+/// HumanML3D names (not through the zero-offset connectors), positions within 1 mm.
+#[test]
+fn own_bvh_export_reads_back_through_read_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("walk.bvh");
+    let walk = crate::render::test_motion::walk(30, 1.2, Vec3::new(0.5, 0.0, -1.0), Vec3::X);
+    write_motion(&path, std::slice::from_ref(&walk), &Meta::new()).unwrap();
+    let LoadedMotion::Joints { people, meta } = read_motion(&path).unwrap() else {
+        panic!("joints expected")
+    };
+    assert_eq!(meta["rig"], "humanml3d");
+    assert_eq!(meta["warnings"], serde_json::json!([]));
+    let back = &people[0].motion;
+    assert_eq!(back.len(), walk.len());
+    for (f, (a, b)) in back.frames.iter().zip(&walk.frames).enumerate() {
+        for j in 0..NUM_JOINTS {
+            let err = (a[j] - b[j]).length();
+            assert!(err < 1e-3, "frame {f} joint {j}: {err} m");
+        }
+    }
+}
+
 #[test]
 fn bvh_through_read_motion_reports_the_import() {
     let dir = tempfile::tempdir().unwrap();

@@ -50,7 +50,7 @@ mod style;
 mod views;
 
 #[cfg(test)]
-mod test_motion;
+pub(crate) mod test_motion;
 #[cfg(test)]
 mod test_util;
 #[cfg(test)]

@@ -2,7 +2,9 @@
 //!
 //! In: a parsed [`Bvh`]. Out: a [`JointMap`]: for every HumanML3D joint either a source
 //! joint or a point between two already-placed HumanML3D joints. Two ways to build it:
-//! * the Bandai-Namco table (exact names, used when all of them are present);
+//! * exact tables, used when all of their names are present: the 22 HumanML3D names
+//!   (mprog's own BVH export, whose zero-offset connector joints must not be taken for
+//!   spine joints) and the Bandai-Namco names;
 //! * name matching for other rigs (CMU, Mixamo, SMPL, UE, Biped, Blender `.L/.R`), with the
 //!   spine taken from the hierarchy between pelvis and neck.
 //!
@@ -108,7 +110,13 @@ pub fn map_joints(bvh: &Bvh) -> Result<JointMap, BvhErrorKind> {
         .iter()
         .map(|(_, n)| bvh.joint_index(n))
         .collect();
-    let rig = if let Some(indices) = bandai {
+    let humanml3d: Option<Vec<usize>> = JOINT_NAMES.iter().map(|n| bvh.joint_index(n)).collect();
+    let rig = if let Some(indices) = humanml3d {
+        for (target, index) in indices.into_iter().enumerate() {
+            found[target] = Some(JointSource::Joint(index));
+        }
+        "humanml3d"
+    } else if let Some(indices) = bandai {
         for ((target, _), index) in BANDAI_NAMES.iter().zip(indices) {
             found[*target] = Some(JointSource::Joint(index));
         }

@@ -3,7 +3,8 @@
 //! In: the raw bytes of a BVH file. Out: a `&str` known to be UTF-8 text without NUL bytes,
 //! and the HIERARCHY section as [`Token`]s (whitespace-separated words, with `{` and `}`
 //! always split off), each tagged with its 1-based line. `\r\n`, tabs and trailing spaces
-//! are all just whitespace.
+//! are all just whitespace. Lines starting with `#` are comments (mprog's own exporter
+//! states units, axes and fps in one; Blender skips them too).
 
 use super::error::{BvhError, BvhErrorKind};
 
@@ -41,6 +42,9 @@ fn line_of(bytes: &[u8], pos: usize) -> usize {
 pub fn tokenize<'a>(lines: impl Iterator<Item = (usize, &'a str)>) -> Vec<Token<'a>> {
     let mut tokens = Vec::new();
     for (line, text) in lines {
+        if text.trim_start().starts_with('#') {
+            continue;
+        }
         for word in text.split_whitespace() {
             split_braces(word, line, &mut tokens);
         }
@@ -104,6 +108,14 @@ mod tests {
                 ("}", 2)
             ]
         );
+    }
+
+    #[test]
+    fn comment_lines_are_skipped() {
+        let toks =
+            tokenize([(1, "HIERARCHY"), (2, "  # units metres { }"), (3, "ROOT a")].into_iter());
+        let texts: Vec<_> = toks.iter().map(|t| (t.text, t.line)).collect();
+        assert_eq!(texts, [("HIERARCHY", 1), ("ROOT", 3), ("a", 3)]);
     }
 
     #[test]
