@@ -126,7 +126,7 @@ impl GuideConfig {
                 self.steps
             )));
         }
-        if !(self.tau.is_finite() && self.tau >= 0.0) || !(self.variance_bound >= 0.0) {
+        if !(self.tau.is_finite() && self.tau >= 0.0 && self.variance_bound >= 0.0) {
             return Err(SolveError::Invalid(
                 "guide: τ and the variance bound must be finite and ≥ 0".into(),
             ));

@@ -53,8 +53,10 @@ impl IkConfig {
 
     pub(crate) fn validate(&self) -> Result<(), SolveError> {
         check_kind(self.sampler)?;
-        if !(self.lr.is_finite() && self.lr >= 0.0)
-            || !(self.smoothness.is_finite() && self.smoothness >= 0.0)
+        if !(self.lr.is_finite()
+            && self.lr >= 0.0
+            && self.smoothness.is_finite()
+            && self.smoothness >= 0.0)
         {
             return Err(SolveError::Invalid(
                 "ik: learning rate and smoothness must be finite and ≥ 0".into(),

@@ -534,18 +534,7 @@ fn host_fk_backward_matches_finite_differences() {
     f(&mut fk, &head);
     let mut g = vec![0.0; head.len()];
     fk.backward(&head, &up, &mut g);
-    for k in [
-        0,
-        1,
-        2,
-        3,
-        4,
-        6,
-        HEAD + 0,
-        HEAD + 2,
-        3 * HEAD + 20,
-        5 * HEAD,
-    ] {
+    for k in [0, 1, 2, 3, 4, 6, HEAD, HEAD + 2, 3 * HEAD + 20, 5 * HEAD] {
         let h = 1e-2;
         let orig = head[k];
         head[k] = orig + h;
@@ -637,4 +626,39 @@ fn ik_reg_is_smoother_than_ik_and_guide_rules_differ_on_dense_errors() {
     );
     eprintln!("wrist: gradient rule {} polyak {}", g.error[0], p.error[0]);
     assert!(p.error[0] < 0.5 * g.error[0]);
+}
+
+#[test]
+fn checkpointed_latent_gradient_matches_the_full_graph() {
+    let bundle = tiny_bundle();
+    let cfg = LatentConfig {
+        iterations: 4,
+        ..small_latent()
+    };
+    let a = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Latent(cfg.clone())),
+        &pelvis_at_end,
+    );
+    let b = run(
+        &bundle,
+        &request(
+            &["a person walks"],
+            Solver::Latent(LatentConfig {
+                checkpoint: false,
+                ..cfg
+            }),
+        ),
+        &pelvis_at_end,
+    );
+    assert!(
+        (a.trace[3][0] - a.trace[0][0]).abs() > 1e-3,
+        "the noise did not move"
+    );
+    for (x, y) in a.trace.iter().zip(&b.trace) {
+        assert!(
+            (x[0] - y[0]).abs() < 1e-4 * x[0].abs().max(1.0),
+            "{x:?} vs {y:?}"
+        );
+    }
 }
