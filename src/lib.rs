@@ -18,8 +18,8 @@
 //! 20 fps; tensors of joint positions are `[batch, people, frames, 22, 3]`.
 
 pub mod dataset;
-pub mod eval;
 pub mod docgen;
+pub mod eval;
 pub mod features;
 pub mod formats;
 pub mod fsutil;

@@ -67,7 +67,9 @@ fn sample_tensor(people: &[Motion], device: &Device) -> Tensor<5> {
 }
 
 fn per_statement(program: &Program, people: &[Motion], device: &Device) -> Result<Vec<f32>> {
-    let e = program.try_evaluate(sample_tensor(people, device)).into_diagnostic()?;
+    let e = program
+        .try_evaluate(sample_tensor(people, device))
+        .into_diagnostic()?;
     e.per_statement
         .into_data()
         .try_into_vec::<f32>()
@@ -83,17 +85,25 @@ fn solve_with_bar(
 ) -> Result<SolveResult> {
     let bar = ProgressBar::new(0);
     bar.set_style(
-        ProgressStyle::with_template(&format!("{label:>9} {{bar:30}} {{pos}}/{{len}} {{msg}} [{{elapsed}}]"))
-            .expect("template"),
+        ProgressStyle::with_template(&format!(
+            "{label:>9} {{bar:30}} {{pos}}/{{len}} {{msg}} [{{elapsed}}]"
+        ))
+        .expect("template"),
     );
     let error = |j: Tensor<5>| program.evaluate(j).total;
-    let out = solve(&Prior::from_bundle(bundle), req, &error, device, |p: Progress| {
-        bar.set_length(p.total as u64);
-        bar.set_position(p.done as u64);
-        if let Some(e) = p.error {
-            bar.set_message(format!("error {e:.4}"));
-        }
-    })
+    let out = solve(
+        &Prior::from_bundle(bundle),
+        req,
+        &error,
+        device,
+        |p: Progress| {
+            bar.set_length(p.total as u64);
+            bar.set_position(p.done as u64);
+            if let Some(e) = p.error {
+                bar.set_message(format!("error {e:.4}"));
+            }
+        },
+    )
     .into_diagnostic()
     .wrap_err_with(|| format!("solver {}", req.solver.name()))?;
     bar.finish_and_clear();
@@ -126,9 +136,8 @@ pub fn run(args: RunArgs) -> Result<()> {
         None
     } else {
         let plain = match &solver {
-            Solver::Latent(_) | Solver::Ik(_) => Solver::by_name("plain").map(|_| {
-                Solver::Plain(mprog::model::sampler::SamplerKind::Ddim(100))
-            }),
+            Solver::Latent(_) | Solver::Ik(_) => Solver::by_name("plain")
+                .map(|_| Solver::Plain(mprog::model::sampler::SamplerKind::Ddim(100))),
             _ => Solver::by_name("plain"),
         }
         .expect("plain exists");
@@ -139,34 +148,74 @@ pub fn run(args: RunArgs) -> Result<()> {
     println!("| line | statement | unit | unguided | {} |", solver.name());
     println!("| --- | --- | --- | --- | --- |");
     for (i, s) in program.statements().iter().enumerate() {
-        let text = s.label.split_once(": ").map_or(s.label.as_str(), |(_, t)| t).trim();
-        let base = baseline.as_ref().map_or("—".into(), |(b, _)| format!("{:.4}", b[i]));
-        println!("| {} | `{text}` | {} | {base} | {:.4} |", s.line, s.unit, guided[i]);
+        let text = s
+            .label
+            .split_once(": ")
+            .map_or(s.label.as_str(), |(_, t)| t)
+            .trim();
+        let base = baseline
+            .as_ref()
+            .map_or("—".into(), |(b, _)| format!("{:.4}", b[i]));
+        println!(
+            "| {} | `{text}` | {} | {base} | {:.4} |",
+            s.line, s.unit, guided[i]
+        );
     }
     let total: f32 = guided.iter().sum();
-    let base_total = baseline.as_ref().map_or("—".into(), |(b, _)| format!("{:.4}", b.iter().sum::<f32>()));
+    let base_total = baseline.as_ref().map_or("—".into(), |(b, _)| {
+        format!("{:.4}", b.iter().sum::<f32>())
+    });
     println!("| | **total** | | {base_total} | {total:.4} |");
     match &baseline {
-        Some((_, s)) => eprintln!("{}: {:.1} s (unguided: {s:.1} s)", solver.name(), result.seconds),
+        Some((_, s)) => eprintln!(
+            "{}: {:.1} s (unguided: {s:.1} s)",
+            solver.name(),
+            result.seconds
+        ),
         None => eprintln!("{}: {:.1} s", solver.name(), result.seconds),
     }
     let mut meta = Meta::new();
-    meta.insert("program".into(), std::fs::read_to_string(&args.program).unwrap_or_default().into());
-    meta.insert("program_file".into(), args.program.display().to_string().into());
+    meta.insert(
+        "program".into(),
+        std::fs::read_to_string(&args.program)
+            .unwrap_or_default()
+            .into(),
+    );
+    meta.insert(
+        "program_file".into(),
+        args.program.display().to_string().into(),
+    );
     meta.insert("overrides".into(), serde_json::json!(args.set));
     meta.insert("seed".into(), args.seed.into());
     meta.insert("solver".into(), format!("{solver:?}").into());
-    meta.insert("weights_id".into(), bundle.manifest.weights_id.clone().into());
+    meta.insert(
+        "weights_id".into(),
+        bundle.manifest.weights_id.clone().into(),
+    );
     meta.insert("prompts".into(), serde_json::json!(prompts));
-    meta.insert("statement_errors".into(), statement_errors(&program, people, &device)?);
-    write_outputs(&args.out, people, &meta, &format!("{} ({})", program.name(), solver.name()))
+    meta.insert(
+        "statement_errors".into(),
+        statement_errors(&program, people, &device)?,
+    );
+    write_outputs(
+        &args.out,
+        people,
+        &meta,
+        &format!("{} ({})", program.name(), solver.name()),
+    )
 }
 
 /// `[{label, line, unit, values}]` for the viewer's timeline (`meta.statement_errors`):
 /// one value per frame of the motion, null where the statement does not apply.
-fn statement_errors(program: &Program, people: &[Motion], device: &Device) -> Result<serde_json::Value> {
+fn statement_errors(
+    program: &Program,
+    people: &[Motion],
+    device: &Device,
+) -> Result<serde_json::Value> {
     let total = people.iter().map(Motion::len).min().unwrap_or(0);
-    let frames = program.evaluate_frames(sample_tensor(people, device)).into_diagnostic()?;
+    let frames = program
+        .evaluate_frames(sample_tensor(people, device))
+        .into_diagnostic()?;
     let list: Vec<serde_json::Value> = program
         .statements()
         .iter()
