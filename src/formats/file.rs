@@ -94,6 +94,22 @@ pub fn read_motion(path: &Path) -> Result<LoadedMotion, FormatError> {
 /// Writes motions (one per person) as `.npy`, `.json` or `.bvh` (one person, Y up,
 /// metres); `meta` goes into JSON only, since `.npy` and BVH hold no free-form fields.
 pub fn write_motion(path: &Path, motions: &[Motion], meta: &Meta) -> Result<(), FormatError> {
+    // JSON would turn ∞/NaN into `null` and `.npy` would carry them: refuse instead.
+    for (p, m) in motions.iter().enumerate() {
+        if let Some(f) = m
+            .frames
+            .iter()
+            .position(|pose| !pose.iter().all(|v| v.is_finite()))
+        {
+            return Err(unsupported(
+                path,
+                format!(
+                    "person {} frame {f} has non-finite joint positions; nothing was written",
+                    p + 1
+                ),
+            ));
+        }
+    }
     match extension(path).as_str() {
         "npy" => Ok(write_joints_npy(path, motions)?),
         "json" => Ok(write_json(path, &default_names(motions.to_vec()), meta)?),
