@@ -375,6 +375,23 @@ fn bvh_infinite_value() {
 }
 
 #[test]
+fn bvh_values_that_overflow_along_the_skeleton() {
+    // Finding: 3e38 on two chained position channels gave ∞ joint positions, written
+    // to JSON as `null` and to .npy as inf.
+    let text = bandai_like();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let first = lines.iter().position(|l| l == "MOTION").unwrap() + 3;
+    for line in &mut lines[first..first + 4] {
+        let mut v: Vec<&str> = line.split(' ').collect();
+        v[7] = "3e38";
+        v[13] = "3e38";
+        *line = v.join(" ");
+    }
+    let m = bvh_error("big.bvh", &lines.join("\n"));
+    assert_mentions(&m, &["big.bvh", "frame 1 of the file", "not finite"]);
+}
+
+#[test]
 fn bvh_zero_frames() {
     let m = no_panic("zero frames", || {
         import_bvh(&fixture("zero_frames.bvh"), &BvhImportOptions::default())
@@ -602,6 +619,20 @@ fn npy_deeply_nested_header_does_not_overflow_the_stack() {
     bytes.extend((h.len() as u16).to_le_bytes());
     bytes.extend(h);
     assert_mentions(&npy_error(bytes), &["bad.npy", "not a valid .npy file"]);
+}
+
+#[test]
+fn npy_backtracking_header_is_refused_quickly() {
+    // Fuzzing finding (npy target, timeout): unclosed `[` in the header made the header
+    // parser backtrack for 15 s.
+    let bytes = std::fs::read(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures/fuzz/npy/backtracking-header.npy"),
+    )
+    .unwrap();
+    let started = std::time::Instant::now();
+    assert_mentions(&npy_error(bytes), &["bad.npy", "brackets"]);
+    assert!(started.elapsed().as_secs() < 2, "{:?}", started.elapsed());
 }
 
 #[test]
@@ -1162,6 +1193,20 @@ fn cli_convert_two_people_to_bvh_writes_none() {
     let out = mprog(dir.path(), &["convert", "two.npy", "-o", "a.json", "b.bvh"]);
     assert_cli_error(&out, &["b.bvh", "2 people"]);
     assert_no_outputs(dir.path(), &["two.npy"]);
+}
+
+#[test]
+fn cli_convert_overflowing_features_writes_nothing() {
+    // Finite but absurd HumanML3D features recover to non-finite joints.
+    let dir = tempfile::tempdir().unwrap();
+    let feats = npy("<f4", &[3, 263], &f32_bytes(&[3e38; 3 * 263]));
+    std::fs::write(dir.path().join("feats.npy"), feats).unwrap();
+    let out = mprog(
+        dir.path(),
+        &["convert", "feats.npy", "-o", "out.json", "out.npy"],
+    );
+    assert_cli_error(&out, &["out.json", "non-finite"]);
+    assert_no_outputs(dir.path(), &["feats.npy"]);
 }
 
 #[test]

@@ -107,7 +107,10 @@ fn replay(root: &Path, per_input: Duration) -> usize {
     let mut count = 0;
     for (target, f) in TARGETS {
         for path in files(&root.join(target)) {
-            let data = std::fs::read(&path).unwrap();
+            // A running fuzzer may delete corpus files it has reduced.
+            let Ok(data) = std::fs::read(&path) else {
+                continue;
+            };
             let started = Instant::now();
             let result = std::thread::Builder::new()
                 .stack_size(2 << 20)
@@ -130,12 +133,12 @@ fn replay(root: &Path, per_input: Duration) -> usize {
 #[test]
 fn fuzzing_findings_stay_fixed() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fuzz");
-    let n = replay(&root, Duration::from_secs(20));
+    let n = replay(&root, Duration::from_secs(5));
     assert!(n >= 1, "no findings under {}", root.display());
 }
 
 #[test]
-#[ignore = "replays the local fuzz corpus (fuzz/corpus/, made by fuzz/run.sh); minutes"]
+#[ignore = "replays the local fuzz corpus (fuzz/corpus/, made by fuzz/run.sh)"]
 fn fuzz_corpus_replays_cleanly() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus");
     let n = replay(&root, Duration::from_secs(20));

@@ -106,6 +106,22 @@ pub fn write_motion_with(
     meta: &Meta,
     bvh: &BvhExportOptions,
 ) -> Result<(), FormatError> {
+    // JSON would turn ∞/NaN into `null` and `.npy` would carry them: refuse instead.
+    for (p, m) in motions.iter().enumerate() {
+        if let Some(f) = m
+            .frames
+            .iter()
+            .position(|pose| !pose.iter().all(|v| v.is_finite()))
+        {
+            return Err(unsupported(
+                path,
+                format!(
+                    "person {} frame {f} has non-finite joint positions; nothing was written",
+                    p + 1
+                ),
+            ));
+        }
+    }
     match extension(path).as_str() {
         "npy" => Ok(write_joints_npy(path, motions)?),
         "json" => Ok(write_json(path, &default_names(motions.to_vec()), meta)?),

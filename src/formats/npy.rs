@@ -107,6 +107,18 @@ pub fn read_npy_bytes(origin: &str, bytes: &[u8]) -> Result<NpyArray, NpyError> 
         origin: origin.into(),
         message,
     };
+    if let Some(text) = header_text(bytes) {
+        let brackets = text.iter().filter(|b| b"([{".contains(b)).count();
+        if brackets > 2 {
+            // A float array's header is `{'descr': '<f4', 'fortran_order': False, 'shape':
+            // (…), }`. npyz's header parser backtracks exponentially on nested brackets
+            // (a fuzzing finding: 25 `[` took 15 s), so anything else is refused here.
+            return Err(header_err(format!(
+                "the header has {brackets} brackets; expected `{{'descr': …, 'fortran_order': …, 'shape': (…)}}` \
+                 (structured dtypes are not supported)"
+            )));
+        }
+    }
     let mut rest = bytes;
     let header = npyz::NpyHeader::from_reader(&mut rest).map_err(|e| header_err(e.to_string()))?;
     let npy = npyz::NpyFile::with_header(header, rest);
@@ -168,6 +180,27 @@ pub fn read_npy_bytes(origin: &str, bytes: &[u8]) -> Result<NpyArray, NpyError> 
         });
     }
     Ok(NpyArray { shape, data })
+}
+
+/// The header dictionary's bytes (possibly cut short by the file's end), if `bytes`
+/// starts like an `.npy` file of a known version.
+fn header_text(bytes: &[u8]) -> Option<&[u8]> {
+    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+        return None;
+    }
+    let (len, start): (usize, usize) = match bytes[6] {
+        1 => (usize::from(u16::from_le_bytes([bytes[8], bytes[9]])), 10),
+        2 | 3 => {
+            let len = bytes.get(8..12)?;
+            (
+                u32::from_le_bytes([len[0], len[1], len[2], len[3]]) as usize,
+                12,
+            )
+        }
+        _ => return None,
+    };
+    let end = start.saturating_add(len).min(bytes.len());
+    bytes.get(start..end)
 }
 
 /// Reorders column-major data to row-major.

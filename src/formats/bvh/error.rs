@@ -104,6 +104,10 @@ pub enum BvhErrorKind {
         missing: Vec<&'static str>,
         available: String,
     },
+    #[error(
+        "frame {frame} of the file: the position of `{joint}` is not finite (values too large to add up along the skeleton)"
+    )]
+    NonFinitePosition { frame: usize, joint: &'static str },
     #[error("invalid import option: {0}")]
     BadOption(String),
 }

@@ -168,6 +168,19 @@ pub fn import_bvh_str(
         .iter()
         .map(|pose| pose.map(|p| opts.up.to_y_up(p) * unit_scale))
         .collect();
+    // Finite values can still add up to ∞ along a chain of joints (or make the unit
+    // detection meaningless): refuse rather than hand out non-finite positions.
+    if let Some((f, j)) = frames
+        .iter()
+        .enumerate()
+        .find_map(|(f, pose)| pose.iter().position(|p| !p.is_finite()).map(|j| (f, j)))
+    {
+        let kind = BvhErrorKind::NonFinitePosition {
+            frame: samples.get(f).map_or(f, |s| s.i0) + 1,
+            joint: crate::skeleton::JOINT_NAMES[j],
+        };
+        return Err(BvhError::whole(origin, kind));
+    }
     let motion = Motion {
         frames,
         fps: opts.fps,
