@@ -24,6 +24,10 @@ pub struct TrainArgs {
     /// Continue the run in `--out` from its last checkpoint.
     #[arg(long)]
     resume: bool,
+    /// Start a new run from a model bundle's weights (e.g. `models/default`) instead of
+    /// random ones; its config and vocabulary must match the training config.
+    #[arg(long, conflicts_with = "resume")]
+    init_from: Option<PathBuf>,
     /// Stop after this many steps in this session (the run can be resumed later).
     #[arg(long)]
     steps: Option<usize>,
@@ -100,6 +104,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         out: args.out.clone(),
         max_steps_now: args.steps,
         interrupt: interrupt.clone(),
+        init_from: args.init_from.clone(),
     };
     let state = run
         .run(&|state, loss, lr| {

@@ -170,6 +170,7 @@ fn training_learns_and_resumes_from_checkpoints() {
         out: dir.path().to_path_buf(),
         max_steps_now: Some(steps),
         interrupt: Default::default(),
+        init_from: None,
     };
     let first = run(30).run(&|_, _, _| {}).unwrap();
     assert_eq!(first.step, 30);
@@ -213,6 +214,7 @@ fn interrupted_training_saves_a_checkpoint_and_resumes() {
         out: dir.path().to_path_buf(),
         max_steps_now: None,
         interrupt: interrupt.clone(),
+        init_from: None,
     };
     // Ctrl-C arrives during step 4, between checkpoints (every 10 steps).
     let stopped = run
@@ -243,4 +245,44 @@ fn interrupted_training_saves_a_checkpoint_and_resumes() {
     assert_eq!(resumed.step, 12);
     let csv = std::fs::read_to_string(dir.path().join("loss.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 12);
+}
+
+#[test]
+fn a_new_run_can_start_from_a_bundle() {
+    let data = synthetic_dataset();
+    let first = tempfile::tempdir().unwrap();
+    let config = TrainConfig {
+        model: tiny(),
+        batch_size: 4,
+        crop_frames: 16,
+        warmup_steps: 1,
+        checkpoint_every: 5,
+        steps: 100,
+        ..TrainConfig::default()
+    };
+    let run = |out: &std::path::Path, init: Option<std::path::PathBuf>, steps| TrainRun {
+        data: &data,
+        config: config.clone(),
+        out: out.to_path_buf(),
+        max_steps_now: Some(steps),
+        interrupt: Default::default(),
+        init_from: init,
+    };
+    run(first.path(), None, 5).run(&|_, _, _| {}).unwrap();
+    let second = tempfile::tempdir().unwrap();
+    let state = run(second.path(), Some(first.path().join("bundle")), 5)
+        .run(&|_, _, _| {})
+        .unwrap();
+    assert_eq!(state.step, 10, "the bundle's 5 steps carry on");
+    // A bundle of another shape is refused.
+    let mut other = config.clone();
+    other.model.d_model = 48;
+    let third = tempfile::tempdir().unwrap();
+    let err = TrainRun {
+        config: other,
+        ..run(third.path(), Some(first.path().join("bundle")), 1)
+    }
+    .run(&|_, _, _| {})
+    .unwrap_err();
+    assert!(err.to_string().contains("does not match"), "{err}");
 }

@@ -24,7 +24,8 @@ use super::noise::NoiseSource;
 use super::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use super::text::{TokenBatch, Vocabulary};
 use super::weights::{
-    BUNDLE_VERSION, Manifest, model_from_safetensors, model_to_safetensors, save_bundle_parts,
+    BUNDLE_VERSION, Manifest, ModelBundle, model_from_safetensors, model_to_safetensors,
+    save_bundle_parts,
 };
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
 use crate::fsutil::write_bytes_atomic;
@@ -169,6 +170,10 @@ pub struct TrainRun<'a> {
     pub max_steps_now: Option<usize>,
     /// Read between steps: when set, the run saves a checkpoint and returns.
     pub interrupt: Interrupt,
+    /// A model bundle to start from when `out` has no checkpoint yet (e.g. the shipped
+    /// weights, when a run's checkpoints were lost): its weights seed both the model and
+    /// the EMA, its vocabulary is kept, and its step count carries on; AdamW starts fresh.
+    pub init_from: Option<PathBuf>,
 }
 
 struct Checkpoint {
@@ -211,6 +216,31 @@ impl TrainRun<'_> {
     ) -> Result<Checkpoint, TrainError> {
         let cfg = &self.config;
         let Some(dir) = self.existing_checkpoint() else {
+            if let Some(init) = &self.init_from {
+                let bundle = ModelBundle::load(init, plain).map_err(|e| file_err(init, e))?;
+                if bundle.config != cfg.model || bundle.vocab != *vocab {
+                    return Err(TrainError::Invalid(format!(
+                        "{} does not match this run: its model config or vocabulary differs from the training config's",
+                        init.display()
+                    )));
+                }
+                // Load into a fresh training module so its parameters track gradients.
+                let weights = init.join("model.safetensors");
+                let bytes = std::fs::read(&weights).map_err(|e| file_err(&weights, e))?;
+                let fresh = Mdm::new(&cfg.model, vocab.len(), train_dev);
+                let model = model_from_safetensors(fresh, bytes, bundle.manifest.half_precision)
+                    .map_err(|e| file_err(&weights, e))?;
+                return Ok(Checkpoint {
+                    model,
+                    ema: bundle.model,
+                    optim: new_optimizer(cfg),
+                    state: TrainState {
+                        step: bundle.manifest.steps,
+                        seconds: bundle.manifest.train_seconds,
+                        ..TrainState::default()
+                    },
+                });
+            }
             let model = Mdm::new(&cfg.model, vocab.len(), train_dev);
             let ema = model.valid().to_device(plain);
             return Ok(Checkpoint {
@@ -321,6 +351,13 @@ impl TrainRun<'_> {
         if p.exists() {
             let text = std::fs::read_to_string(&p).map_err(|e| file_err(&p, e))?;
             return serde_json::from_str(&text).map_err(|e| file_err(&p, e));
+        }
+        if let Some(init) = &self.init_from {
+            let v = init.join("vocab.json");
+            let text = std::fs::read_to_string(&v).map_err(|e| file_err(&v, e))?;
+            std::fs::create_dir_all(&self.out).map_err(|e| file_err(&self.out, e))?;
+            write_bytes_atomic(&p, text.as_bytes()).map_err(|e| file_err(&p, e))?;
+            return serde_json::from_str(&text).map_err(|e| file_err(&v, e));
         }
         let captions = self
             .data
