@@ -274,7 +274,8 @@ fn every_program_scores_a_real_clip() {
                 }
             }
         }
-        let joints = Tensor::<5>::from_data(TensorData::new(data, [1, people, frames, 22, 3]), &dev);
+        let joints =
+            Tensor::<5>::from_data(TensorData::new(data, [1, people, frames, 22, 3]), &dev);
         let per = prog.try_evaluate(joints).unwrap().per_statement;
         let per = per.into_data().try_into_vec::<f32>().unwrap();
         assert!(per.iter().all(|v| v.is_finite()), "{name}: {per:?}");

@@ -176,6 +176,10 @@ fn training_learns_and_resumes_from_checkpoints() {
     assert_eq!(first.step, 30);
     assert!(dir.path().join("ckpt/state.json").exists());
     assert!(dir.path().join("bundle/model.safetensors").exists());
+    assert!(
+        dir.path().join("loss.png").exists(),
+        "the loss curves are plotted"
+    );
     let second = run(30).run(&|_, _, _| {}).unwrap();
     assert_eq!(second.step, 60, "resumed from step 30");
     let csv = std::fs::read_to_string(dir.path().join("loss.csv")).unwrap();

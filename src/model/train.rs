@@ -11,6 +11,7 @@
 //! <out>/bundle/            the EMA weights as a shippable model bundle (f16)
 //! <out>/loss.csv           step, train loss, learning rate, seconds
 //! <out>/val.csv            step, validation loss of the EMA weights
+//! <out>/loss.png           both curves, plotted at every checkpoint
 //! ```
 //!
 //! A checkpoint is written whole into `ckpt.new/` and then swapped in by renames, so a
@@ -506,8 +507,63 @@ impl TrainRun<'_> {
                 &format!("{},{v},{:.1}\n", ck.state.step, ck.state.seconds),
             )?;
         }
+        // A picture of the curves; a plotting problem must not stop training.
+        if let Err(e) = plot_loss_curves(&self.out) {
+            eprintln!("warning: could not plot the loss curves: {e}");
+        }
         self.save(ck, vocab)
     }
+}
+
+/// `(step, value)` pairs of column `col` of a CSV written by [`append`].
+fn read_curve(path: &Path, col: usize) -> Vec<(f32, f32)> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Vec::new();
+    };
+    text.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let mut f = l.split(',');
+            let step = f.next()?.parse().ok()?;
+            let v = f.nth(col - 1)?.parse().ok()?;
+            Some((step, v))
+        })
+        .collect()
+}
+
+/// `<out>/loss.png`: training loss (mean over 50-step windows) and validation loss, log y.
+pub fn plot_loss_curves(out: &Path) -> Result<(), String> {
+    let raw = read_curve(&out.join("loss.csv"), 1);
+    let train: Vec<(f32, f32)> = raw
+        .chunks(50)
+        .map(|c| {
+            let n = c.len() as f32;
+            (c[c.len() - 1].0, c.iter().map(|p| p.1).sum::<f32>() / n)
+        })
+        .collect();
+    let series = vec![
+        crate::render::Series {
+            name: "train (50-step mean)".into(),
+            points: train,
+        },
+        crate::render::Series {
+            name: "validation (EMA)".into(),
+            points: read_curve(&out.join("val.csv"), 1),
+        },
+    ];
+    let opts = crate::render::PlotOptions {
+        log_y: true,
+        ..Default::default()
+    };
+    crate::render::plot_lines(
+        &out.join("loss.png"),
+        "training loss",
+        "step",
+        "x0 MSE (normalised)",
+        &series,
+        &opts,
+    )
+    .map_err(|e| e.to_string())
 }
 
 fn append(path: &Path, header: &str, rows: &str) -> Result<(), TrainError> {
