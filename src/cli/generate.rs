@@ -1,6 +1,6 @@
 //! `mprog gen`: text-to-motion with the shipped model, no program.
 
-use super::io::{check_outputs, numbered, write_outputs};
+use super::io::{check_outputs, numbered, write_outputs_with};
 use burn::prelude::*;
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr};
@@ -46,6 +46,8 @@ pub struct GenArgs {
     /// Outputs by extension: .bvh .npy .json .gif .png (several allowed).
     #[arg(short, long, num_args = 1.., required = true)]
     out: Vec<PathBuf>,
+    #[command(flatten)]
+    export: super::export::ExportArgs,
 }
 
 /// Parses `--sampler`/`--steps`.
@@ -64,6 +66,7 @@ pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
 pub fn run(args: GenArgs) -> Result<()> {
     let started = Instant::now();
     check_outputs(&args.out, 1)?;
+    args.export.check_against(&args.out)?;
     let device = Device::flex();
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let bundle = ModelBundle::load(&dir, &device)
@@ -127,11 +130,12 @@ pub fn run(args: GenArgs) -> Result<()> {
         }
         let mut m = meta.clone();
         m.insert("sample".into(), i.into());
-        write_outputs(
+        write_outputs_with(
             &numbered(&args.out, i, count),
             std::slice::from_ref(motion),
             &m,
             &args.text,
+            &args.export,
         )?;
     }
     eprintln!(

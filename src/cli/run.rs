@@ -2,7 +2,7 @@
 //! the program's error through a solver, print each statement's error next to the
 //! unguided sample's, and write the outputs with everything needed to reproduce them.
 
-use super::io::{check_outputs, write_outputs};
+use super::io::{check_outputs, write_outputs_with};
 use super::score::compile_file;
 use burn::prelude::*;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -41,6 +41,8 @@ pub struct RunArgs {
     /// Outputs by extension: .bvh (one person) .npy .json .gif .png.
     #[arg(short, long, num_args = 1.., required = true)]
     out: Vec<PathBuf>,
+    #[command(flatten)]
+    export: super::export::ExportArgs,
 }
 
 fn prompts_of(program: &Program, text: &Option<String>) -> Result<Vec<String>> {
@@ -122,6 +124,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     })?;
     let prompts = prompts_of(&program, &args.text)?;
     check_outputs(&args.out, prompts.len())?;
+    args.export.check_against(&args.out)?;
     let device = Device::flex();
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let bundle = ModelBundle::load(&dir, &device)
@@ -197,11 +200,12 @@ pub fn run(args: RunArgs) -> Result<()> {
         "statement_errors".into(),
         statement_errors(&program, people, &device)?,
     );
-    write_outputs(
+    write_outputs_with(
         &args.out,
         people,
         &meta,
         &format!("{} ({})", program.name(), solver.name()),
+        &args.export,
     )
 }
 
