@@ -15,7 +15,6 @@ use crate::dataset::store::{read_f32_npy, write_f32_npy};
 use crate::fsutil::write_bytes_atomic;
 use crate::model::text::{TokenBatch, Vocabulary};
 use burn::prelude::*;
-use burn::store::{HalfPrecisionAdapter, ModuleSnapshot, SafetensorsStore};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -83,50 +82,16 @@ fn read_text(path: &Path) -> Result<String, EvalError> {
 
 /// SafeTensors bytes of the networks.
 pub fn net_to_safetensors(net: &EvaluatorNet, half: bool) -> Result<Vec<u8>, String> {
-    let mut store = SafetensorsStore::from_bytes(None);
-    if half {
-        store = store.with_to_adapter(HalfPrecisionAdapter::new());
-    }
-    net.save_into(&mut store).map_err(|e| e.to_string())?;
-    store.get_bytes().map_err(|e| e.to_string())
+    crate::model::weights::module_to_safetensors(net, half)
 }
 
 /// Loads SafeTensors bytes into fresh networks; every tensor must be there, shaped right.
 pub fn net_from_safetensors(
-    mut net: EvaluatorNet,
+    net: EvaluatorNet,
     bytes: Vec<u8>,
     half: bool,
 ) -> Result<EvaluatorNet, String> {
-    let mut store = SafetensorsStore::from_bytes(Some(bytes));
-    if half {
-        store = store.with_from_adapter(HalfPrecisionAdapter::new());
-    }
-    let result = net.load_from(&mut store).map_err(|e| {
-        let text: String = e.to_string().chars().take(400).collect();
-        format!("weights do not fit the configured evaluator: {text}")
-    })?;
-    if !result.errors.is_empty() || !result.missing.is_empty() {
-        return Err(format!(
-            "weights do not fit the configured evaluator: {} errors ({}), {} missing tensors ({})",
-            result.errors.len(),
-            result
-                .errors
-                .iter()
-                .take(3)
-                .map(|e| format!("{e:?}"))
-                .collect::<Vec<_>>()
-                .join("; "),
-            result.missing.len(),
-            result
-                .missing
-                .iter()
-                .take(3)
-                .map(|m| format!("{m:?}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
-    }
-    Ok(net)
+    crate::model::weights::module_from_safetensors(net, bytes, half, "evaluator")
 }
 
 impl Evaluator {

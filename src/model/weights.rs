@@ -104,51 +104,55 @@ fn write_err(path: &Path, e: impl std::fmt::Display) -> WeightsError {
     }
 }
 
-/// Serialises a denoiser to SafeTensors bytes.
-pub fn model_to_safetensors(model: &Mdm, half: bool) -> Result<Vec<u8>, String> {
+/// Serialises any module to SafeTensors bytes (f16 values when `half`).
+pub fn module_to_safetensors<M: Module>(module: &M, half: bool) -> Result<Vec<u8>, String> {
     let mut store = SafetensorsStore::from_bytes(None);
     if half {
         store = store.with_to_adapter(HalfPrecisionAdapter::new());
     }
-    model.save_into(&mut store).map_err(|e| e.to_string())?;
+    module.save_into(&mut store).map_err(|e| e.to_string())?;
     store.get_bytes().map_err(|e| e.to_string())
 }
 
-/// Loads SafeTensors bytes into a freshly built denoiser; every tensor must be present
-/// with the right shape.
-pub fn model_from_safetensors(mut model: Mdm, bytes: Vec<u8>, half: bool) -> Result<Mdm, String> {
+/// Loads SafeTensors bytes into a freshly built module; every tensor must be present with
+/// the right shape. `what` names the module in errors ("model", "evaluator").
+pub fn module_from_safetensors<M: Module>(
+    mut module: M,
+    bytes: Vec<u8>,
+    half: bool,
+    what: &str,
+) -> Result<M, String> {
     let mut store = SafetensorsStore::from_bytes(Some(bytes));
     if half {
         store = store.with_from_adapter(HalfPrecisionAdapter::new());
     }
-    let result = model.load_from(&mut store).map_err(|e| {
+    let result = module.load_from(&mut store).map_err(|e| {
         let text = e.to_string();
         let short: String = text.chars().take(400).collect();
         let more = if text.len() > short.len() { " …" } else { "" };
-        format!("weights do not fit the configured model: {short}{more}")
+        format!("weights do not fit the configured {what}: {short}{more}")
     })?;
     if !result.errors.is_empty() || !result.missing.is_empty() {
+        let first = |items: Vec<String>| items.into_iter().take(3).collect::<Vec<_>>().join("; ");
         return Err(format!(
-            "weights do not fit the configured model: {} errors ({}), {} missing tensors ({})",
+            "weights do not fit the configured {what}: {} errors ({}), {} missing tensors ({})",
             result.errors.len(),
-            result
-                .errors
-                .iter()
-                .take(3)
-                .map(|e| format!("{e:?}"))
-                .collect::<Vec<_>>()
-                .join("; "),
+            first(result.errors.iter().map(|e| format!("{e:?}")).collect()),
             result.missing.len(),
-            result
-                .missing
-                .iter()
-                .take(3)
-                .map(|m| format!("{m:?}"))
-                .collect::<Vec<_>>()
-                .join(", ")
+            first(result.missing.iter().map(|m| format!("{m:?}")).collect()),
         ));
     }
-    Ok(model)
+    Ok(module)
+}
+
+/// Serialises a denoiser to SafeTensors bytes.
+pub fn model_to_safetensors(model: &Mdm, half: bool) -> Result<Vec<u8>, String> {
+    module_to_safetensors(model, half)
+}
+
+/// Loads SafeTensors bytes into a freshly built denoiser.
+pub fn model_from_safetensors(model: Mdm, bytes: Vec<u8>, half: bool) -> Result<Mdm, String> {
+    module_from_safetensors(model, bytes, half, "model")
 }
 
 impl ModelBundle {
