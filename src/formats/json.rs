@@ -211,19 +211,27 @@ impl PersonTrack {
     }
 }
 
+impl JsonError {
+    /// A serde_json parse error as `origin:line:column: message`.
+    pub fn syntax(origin: &str, e: &serde_json::Error) -> Self {
+        let text = e.to_string();
+        JsonError::Syntax {
+            origin: origin.into(),
+            line: e.line(),
+            column: e.column(),
+            message: text
+                .split(" at line ")
+                .next()
+                .unwrap_or_default()
+                .to_string(),
+        }
+    }
+}
+
 /// Parses and validates a document.
 pub fn read_json_str(origin: &str, text: &str) -> Result<(Vec<Person>, Meta), JsonError> {
-    let doc: MotionDocument = serde_json::from_str(text).map_err(|e| JsonError::Syntax {
-        origin: origin.into(),
-        line: e.line(),
-        column: e.column(),
-        message: e
-            .to_string()
-            .split(" at line ")
-            .next()
-            .unwrap_or_default()
-            .to_string(),
-    })?;
+    let doc: MotionDocument =
+        serde_json::from_str(text).map_err(|e| JsonError::syntax(origin, &e))?;
     let people = doc.validate(origin)?;
     Ok((people, doc.meta))
 }

@@ -72,17 +72,8 @@ pub fn read_sidecar_meta(path: &Path) -> Result<Option<Meta>, JsonError> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(source) => return Err(JsonError::Io { origin, source }),
     };
-    let doc: SidecarDocument = serde_json::from_str(&text).map_err(|e| JsonError::Syntax {
-        origin: origin.clone(),
-        line: e.line(),
-        column: e.column(),
-        message: e
-            .to_string()
-            .split(" at line ")
-            .next()
-            .unwrap_or_default()
-            .to_string(),
-    })?;
+    let doc: SidecarDocument =
+        serde_json::from_str(&text).map_err(|e| JsonError::syntax(&origin, &e))?;
     if doc.format != SIDECAR_FORMAT || doc.version != 1 {
         return Err(JsonError::Invalid {
             origin,
