@@ -17,6 +17,7 @@
 //! Conventions everywhere: HumanML3D 22-joint skeleton ([`skeleton`]), metres, Y up,
 //! 20 fps; tensors of joint positions are `[batch, people, frames, 22, 3]`.
 
+pub mod backend;
 pub mod dataset;
 pub mod docgen;
 pub mod eval;
@@ -31,4 +32,5 @@ pub mod render;
 pub mod repl;
 pub mod skeleton;
 pub mod solve;
+pub mod tasks;
 pub mod view;

@@ -268,3 +268,20 @@ fn commands_report_usage() {
     assert!(say(&mut s, ":help eval").contains(":eval EXPR"));
     assert!(s.handle(":quit").quit);
 }
+
+#[test]
+fn run_solves_the_session_program_with_the_shipped_model() {
+    let mut s = Session::new(Some(mprog::model::weights::default_model_dir()));
+    say(&mut s, "prompt \"a person walks forward\"");
+    say(&mut s, "length 1s");
+    say(&mut s, "at end { pelvis.z > 1 m }");
+    // A short chain keeps the test quick; guide with 10 steps still moves the pelvis.
+    let out = say(&mut s, ":run guide 3 steps=10 k_late=20 late_steps=2");
+    assert!(out.contains("guide in") && out.contains("line 3"), "{out}");
+    let score = say(&mut s, ":eval pelvis.z");
+    assert!(score.contains("max"), "{score}");
+    assert!(fails(&mut s, ":run warp").contains("unknown solver"));
+    assert!(fails(&mut s, ":run latent 1 k_late=3").contains("ddim_steps"));
+    let mut empty = Session::new(None);
+    assert!(fails(&mut empty, ":run").contains("length"));
+}

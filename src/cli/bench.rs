@@ -16,6 +16,9 @@ use std::time::Instant;
 pub enum BenchCommand {
     /// Denoiser forward / forward+backward and DDIM sampling times.
     Model(ModelBenchArgs),
+    /// The task suite: every solver on PMG's tasks, keyframe control of test clips and
+    /// two-person contacts; writes a markdown table.
+    Tasks(super::bench_tasks::TaskBenchArgs),
 }
 
 /// Arguments of `mprog bench model`.
@@ -37,6 +40,7 @@ pub struct ModelBenchArgs {
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
         BenchCommand::Model(args) => bench_model(args),
+        BenchCommand::Tasks(args) => super::bench_tasks::run(args),
     }
 }
 
@@ -54,7 +58,7 @@ fn median_ms(reps: usize, mut f: impl FnMut()) -> f64 {
 }
 
 fn bench_model(args: ModelBenchArgs) -> Result<()> {
-    let plain = Device::flex();
+    let plain = super::device()?;
     let dir = args
         .model
         .clone()
@@ -71,10 +75,12 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
     };
     let n = args.frames;
     println!(
-        "denoiser d_model {} × {} layers, {} params, {n} frames, flex backend, median of {} runs\n",
+        "denoiser d_model {} × {} layers, {} params, {n} frames, {} backend on {}, median of {} runs\n",
         config.d_model,
         config.layers,
         model.num_params(),
+        mprog::backend::backend_name(),
+        mprog::backend::machine_description(),
         args.reps
     );
     println!("| measurement | batch 1 | batch 32 |\n| --- | --- | --- |");

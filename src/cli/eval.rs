@@ -149,7 +149,7 @@ fn train_encoder(args: TrainEncoderArgs) -> Result<()> {
 
 fn evaluate(args: RunArgs) -> Result<()> {
     let data_dir = args.data.ok_or_else(|| miette!("--data is required"))?;
-    let device = burn::prelude::Device::flex();
+    let device = super::device()?;
     let data = Dataset::load(&data_dir).into_diagnostic()?;
     let model_dir = args.model.unwrap_or_else(default_model_dir);
     let bundle = ModelBundle::load(&model_dir, &device)

@@ -1,7 +1,6 @@
 //! `mprog gen`: text-to-motion with the shipped model, no program.
 
 use super::io::{check_outputs, numbered, write_outputs_with};
-use burn::prelude::*;
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr};
 use mprog::formats::Meta;
@@ -67,7 +66,7 @@ pub fn run(args: GenArgs) -> Result<()> {
     let started = Instant::now();
     check_outputs(&args.out, 1)?;
     args.export.check_against(&args.out)?;
-    let device = Device::flex();
+    let device = super::device()?;
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()

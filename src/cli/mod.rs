@@ -1,6 +1,7 @@
 //! Subcommands of the `mprog` binary, one file each.
 
 pub mod bench;
+pub mod bench_tasks;
 pub mod check;
 pub mod convert;
 pub mod data;
@@ -14,3 +15,8 @@ pub mod run;
 pub mod score;
 pub mod train;
 pub mod view;
+
+/// The burn device of this command: flex, or the GPU backend named by `MPROG_DEVICE`.
+pub fn device() -> miette::Result<burn::prelude::Device> {
+    mprog::backend::device_from_env().map_err(|e| miette::miette!("{e}"))
+}

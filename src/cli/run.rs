@@ -23,6 +23,10 @@ pub struct RunArgs {
     /// Solver: guide (OmniControl), latent (PMG), ik, ik-reg, lbfgs (InterControl), plain.
     #[arg(long, default_value = "guide")]
     solver: String,
+    /// Solver setting, repeatable: `--knob iterations=30 --knob ddim_steps=20` (latent),
+    /// `--knob steps=100` (guide, lbfgs, plain); an unknown name lists the valid ones.
+    #[arg(long = "knob", value_parser = super::check::parse_override)]
+    knobs: Vec<(String, f64)>,
     /// Seed: the same program, seed, settings and weights give the same motion.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -112,20 +116,30 @@ fn solve_with_bar(
     Ok(out)
 }
 
+/// The solver named `name` with the `--knob` settings applied.
+pub fn solver_with_knobs(name: &str, knobs: &[(String, f64)]) -> Result<Solver> {
+    let mut solver = Solver::by_name(name).ok_or_else(|| {
+        miette!(
+            help = "use guide, latent, ik, ik-reg, lbfgs or plain",
+            "unknown solver `{name}`"
+        )
+    })?;
+    for (k, v) in knobs {
+        solver
+            .set_knob(k, *v)
+            .map_err(|e| miette!("--knob {k}={v}: {e}"))?;
+    }
+    Ok(solver)
+}
+
 /// Runs `mprog run`.
 pub fn run(args: RunArgs) -> Result<()> {
     let program = compile_file(&args.program, &args.set)?;
-    let solver = Solver::by_name(&args.solver).ok_or_else(|| {
-        miette!(
-            help = "use guide, latent, ik, ik-reg, lbfgs or plain",
-            "unknown solver `{}`",
-            args.solver
-        )
-    })?;
+    let solver = solver_with_knobs(&args.solver, &args.knobs)?;
     let prompts = prompts_of(&program, &args.text)?;
     check_outputs(&args.out, prompts.len())?;
     args.export.check_against(&args.out)?;
-    let device = Device::flex();
+    let device = super::device()?;
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
@@ -138,13 +152,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let baseline = if args.no_baseline {
         None
     } else {
-        let plain = match &solver {
-            Solver::Latent(_) | Solver::Ik(_) => Solver::by_name("plain")
-                .map(|_| Solver::Plain(mprog::model::sampler::SamplerKind::Ddim(100))),
-            _ => Solver::by_name("plain"),
-        }
-        .expect("plain exists");
-        let req = SolveRequest::new(prompts.clone(), frames, args.seed, plain);
+        let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.unguided());
         let r = solve_with_bar(&bundle, &req, &program, &device, "unguided")?;
         Some((per_statement(&program, &r.motions[0], &device)?, r.seconds))
     };
@@ -163,6 +171,16 @@ pub fn run(args: RunArgs) -> Result<()> {
             "| {} | `{text}` | {} | {base} | {:.4} |",
             s.line, s.unit, guided[i]
         );
+    }
+    if let Some((base, _)) = &baseline {
+        for (s, b) in program.statements().iter().zip(base) {
+            if *b <= 0.0 && ["<", ">", "<=", ">="].iter().any(|op| s.label.contains(op)) {
+                eprintln!(
+                    "warning: line {}: already satisfied on every frame by the unguided motion, so it steers nothing (is the inequality the right way round?)",
+                    s.line
+                );
+            }
+        }
     }
     let total: f32 = guided.iter().sum();
     let base_total = baseline.as_ref().map_or("—".into(), |(b, _)| {
@@ -189,6 +207,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         args.program.display().to_string().into(),
     );
     meta.insert("overrides".into(), serde_json::json!(args.set));
+    meta.insert("knobs".into(), serde_json::json!(args.knobs));
     meta.insert("seed".into(), args.seed.into());
     meta.insert("solver".into(), format!("{solver:?}").into());
     meta.insert(

@@ -61,7 +61,7 @@ pub fn run(args: ScoreArgs) -> Result<()> {
             people.len()
         ));
     }
-    let device = Device::flex();
+    let device = super::device()?;
     let joints = people_tensor(&people, &device);
     let evaluation = program.try_evaluate(joints.clone()).into_diagnostic()?;
     let traces = program.evaluate_frames(joints).into_diagnostic()?;

@@ -105,6 +105,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         max_steps_now: args.steps,
         interrupt: interrupt.clone(),
         init_from: args.init_from.clone(),
+        device: super::device()?,
     };
     let state = run
         .run(&|state, loss, lr| {

@@ -171,6 +171,7 @@ fn training_learns_and_resumes_from_checkpoints() {
         max_steps_now: Some(steps),
         interrupt: Default::default(),
         init_from: None,
+        device: Device::flex(),
     };
     let first = run(30).run(&|_, _, _| {}).unwrap();
     assert_eq!(first.step, 30);
@@ -219,6 +220,7 @@ fn interrupted_training_saves_a_checkpoint_and_resumes() {
         max_steps_now: None,
         interrupt: interrupt.clone(),
         init_from: None,
+        device: Device::flex(),
     };
     // Ctrl-C arrives during step 4, between checkpoints (every 10 steps).
     let stopped = run
@@ -271,6 +273,7 @@ fn a_new_run_can_start_from_a_bundle() {
         max_steps_now: Some(steps),
         interrupt: Default::default(),
         init_from: init,
+        device: Device::flex(),
     };
     run(first.path(), None, 5).run(&|_, _, _| {}).unwrap();
     let second = tempfile::tempdir().unwrap();

@@ -29,8 +29,11 @@ use super::weights::{
     save_bundle_parts,
 };
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
+use crate::features::layout::CONTACT;
+use crate::features::recover_from_ric_tensor;
 use crate::fsutil::write_bytes_atomic;
 use crate::interrupt::Interrupt;
+use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT};
 use burn::module::Module;
 use burn::optim::{
     AdamWConfig, GradientsParams, ModuleOptimizer, grad_clipping::GradientClippingConfig,
@@ -145,18 +148,72 @@ pub fn masked_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1>
     err.sum() / (valid.sum() * f)
 }
 
-/// Loss of one batch.
+/// Foot-contact loss (MDM's L_foot): the squared per-frame displacement, in cm², of each
+/// foot joint (ankles and toes) of the predicted motion on the frame pairs where the
+/// data's contact label says that joint is planted, averaged over those pairs.
+pub struct FootLoss {
+    /// Weight of the term in the training loss.
+    pub weight: f32,
+    /// `[1, 1, 263]` feature mean, to de-normalise predictions.
+    pub mean: Tensor<3>,
+    /// `[1, 1, 263]` feature std.
+    pub std: Tensor<3>,
+}
+
+impl FootLoss {
+    /// The loss for a dataset's statistics, or None when `weight` is 0.
+    pub fn new(weight: f64, mean: &[f32], std: &[f32], device: &Device) -> Option<Self> {
+        let stat =
+            |v: &[f32]| Tensor::from_data(TensorData::new(v.to_vec(), [1, 1, v.len()]), device);
+        (weight > 0.0).then(|| FootLoss {
+            weight: weight as f32,
+            mean: stat(mean),
+            std: stat(std),
+        })
+    }
+
+    /// The term for normalised prediction and target `[B, N, 263]`, `valid` `[B, N, 1]`.
+    pub fn term(&self, pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+        let [b, n, _] = pred.dims();
+        if n < 2 {
+            return Tensor::zeros([1], &pred.device());
+        }
+        let device = pred.device();
+        let joints = recover_from_ric_tensor(pred * self.std.clone() + self.mean.clone());
+        let feet: Vec<i64> = FOOT_LEFT
+            .iter()
+            .chain(FOOT_RIGHT.iter())
+            .map(|&j| j as i64)
+            .collect();
+        let feet = joints.select(2, Tensor::from_data(TensorData::new(feet, [4]), &device)); // [B, N, 4, 3]
+        let step = (feet.clone().narrow(1, 1, n - 1) - feet.narrow(1, 0, n - 1)).mul_scalar(100.0);
+        let slide = step.powi_scalar(2).sum_dim(3).reshape([b, n - 1, 4]);
+        let c = CONTACT.start;
+        let label = x0.narrow(2, c, 4) * self.std.clone().narrow(2, c, 4)
+            + self.mean.clone().narrow(2, c, 4);
+        let both_valid = valid.clone().narrow(1, 0, n - 1) * valid.narrow(1, 1, n - 1);
+        let planted = label.narrow(1, 0, n - 1).greater_elem(0.5).float() * both_valid;
+        (slide * planted.clone()).sum() / (planted.sum() + 1.0)
+    }
+}
+
+/// Loss of one batch: the x0 MSE, plus the foot-contact term when `foot` is given.
 fn batch_loss(
     model: &Mdm,
     schedule: &NoiseSchedule,
     batch: &HostBatch,
     vocab: &Vocabulary,
+    foot: Option<&FootLoss>,
     device: &Device,
 ) -> Tensor<1> {
     let (mut input, x0, valid) = to_device(batch, vocab, device);
     input.x_t = q_sample(schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
     let pred = model.predict_x0(&input);
-    masked_mse(pred, x0, valid)
+    let mse = masked_mse(pred.clone(), x0.clone(), valid.clone());
+    match foot {
+        Some(f) => mse + f.term(pred, x0, valid).mul_scalar(f.weight),
+        None => mse,
+    }
 }
 
 /// Everything a run needs besides the model.
@@ -175,6 +232,8 @@ pub struct TrainRun<'a> {
     /// weights, when a run's checkpoints were lost): its weights seed both the model and
     /// the EMA, its vocabulary is kept, and its step count carries on; AdamW starts fresh.
     pub init_from: Option<PathBuf>,
+    /// The device to train on (without autodiff; the run adds it).
+    pub device: Device,
 }
 
 struct Checkpoint {
@@ -397,7 +456,7 @@ impl TrainRun<'_> {
         for r in 0..rounds {
             // Fixed "steps" far beyond any real step keep validation batches constant.
             let batch = draw_batch(self.data, &clips, &cfg, usize::MAX - r);
-            let loss = batch_loss(ema, schedule, &batch, vocab, device);
+            let loss = batch_loss(ema, schedule, &batch, vocab, None, device);
             total += loss.into_scalar::<f32>() as f64;
         }
         Some(total / rounds as f64)
@@ -416,10 +475,11 @@ impl TrainRun<'_> {
             ));
         }
         let vocab = self.vocabulary()?;
-        let plain = Device::flex();
+        let plain = self.device.clone();
         let device = plain.clone().autodiff();
         let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
         let mut ck = self.load_or_init(&vocab, &device, &plain)?;
+        let foot = FootLoss::new(cfg.foot_loss, &self.data.mean, &self.data.std, &device);
         let stop_at = match self.max_steps_now {
             Some(n) => (ck.state.step + n).min(cfg.steps),
             None => cfg.steps,
@@ -434,7 +494,7 @@ impl TrainRun<'_> {
             }
             let step = ck.state.step;
             let batch = draw_batch(self.data, &train, cfg, step);
-            let loss = batch_loss(&ck.model, &schedule, &batch, &vocab, &device);
+            let loss = batch_loss(&ck.model, &schedule, &batch, &vocab, foot.as_ref(), &device);
             let value = loss.clone().into_scalar::<f32>();
             if !value.is_finite() {
                 return Err(TrainError::Diverged { step, loss: value });

@@ -20,6 +20,15 @@ pub enum Command {
         /// Noise seed.
         seed: u64,
     },
+    /// `:run [SOLVER] [SEED] [name=value …]`: solve the session's program with the model.
+    Run {
+        /// Solver name (`guide` by default).
+        solver: String,
+        /// Noise seed.
+        seed: u64,
+        /// Solver knobs.
+        knobs: Vec<(String, f64)>,
+    },
     /// `:eval <expr or statement>`: its value or error per frame of the current motion.
     Eval(String),
     /// `:grad <statement>`: gradient magnitude per joint.
@@ -81,6 +90,12 @@ pub const COMMANDS: &[CommandDoc] = &[
         &[],
         "\"PROMPT\" [SECONDS] [SEED]",
         "generate the current motion with the model (default 6 s, seed 1)",
+    ),
+    doc(
+        "run",
+        &[],
+        "[SOLVER] [SEED] [KNOB=VALUE …]",
+        "solve the session's program with the model (guide, latent, lbfgs, ik, ik-reg, plain; default guide, seed 1); the result becomes the current motion",
     ),
     doc(
         "eval",
@@ -189,6 +204,7 @@ fn parse_args(cmd: &CommandDoc, args: &str) -> Result<Command, String> {
         "eval" => need("an expression or a statement").map(Command::Eval),
         "grad" => need("a statement").map(Command::Grad),
         "gen" => parse_gen(args).map_err(|e| format!("{e}; {}", usage())),
+        "run" => parse_run(args).map_err(|e| format!("{e}; {}", usage())),
         "score" => none(Command::Score),
         "show" => none(Command::Show),
         "clear" => none(Command::Clear),
@@ -207,6 +223,27 @@ fn unquote(s: &str) -> String {
         .and_then(|r| r.strip_suffix('"'))
         .unwrap_or(s)
         .to_string()
+}
+
+fn parse_run(args: &str) -> Result<Command, String> {
+    let (mut solver, mut seed, mut knobs) = ("guide".to_string(), 1, Vec::new());
+    for (i, w) in args.split_whitespace().enumerate() {
+        if let Some((k, v)) = w.split_once('=') {
+            let v: f64 = v.parse().map_err(|_| format!("`{v}` is not a number"))?;
+            knobs.push((k.to_string(), v));
+        } else if let Ok(n) = w.parse::<u64>() {
+            seed = n;
+        } else if i == 0 {
+            solver = w.to_string();
+        } else {
+            return Err(format!("unexpected `{w}`"));
+        }
+    }
+    Ok(Command::Run {
+        solver,
+        seed,
+        knobs,
+    })
 }
 
 fn parse_gen(args: &str) -> Result<Command, String> {
@@ -270,6 +307,24 @@ mod tests {
         assert_eq!(cmd(":e head.y"), Command::Eval("head.y".into()));
         assert_eq!(cmd(":grad head.y > 1"), Command::Grad("head.y > 1".into()));
         assert_eq!(cmd(":q"), Command::Quit);
+        assert_eq!(
+            cmd(":run"),
+            Command::Run {
+                solver: "guide".into(),
+                seed: 1,
+                knobs: vec![]
+            }
+        );
+        assert_eq!(
+            cmd(":run latent 7 iterations=20"),
+            Command::Run {
+                solver: "latent".into(),
+                seed: 7,
+                knobs: vec![("iterations".into(), 20.0)]
+            }
+        );
+        assert!(parse(":run guide x y").is_err());
+        assert!(parse(":run guide steps=abc").is_err());
         assert_eq!(cmd(":exit"), Command::Quit);
         assert_eq!(cmd(":?"), Command::Help(None));
         assert_eq!(cmd(":help :eval"), Command::Help(Some("eval".into())));

@@ -150,6 +150,8 @@ pub fn run(mut session: Session, opts: &FrontendOptions) -> rustyline::Result<()
         }
         if input.trim_start().starts_with(":gen") {
             println!("generating (this takes a while on the CPU)…");
+        } else if input.trim_start().starts_with(":run") {
+            println!("solving (a minute or more on the CPU at the solver's defaults)…");
         }
         let reply = session.handle(&input);
         print!("{}", reply.render(fancy));

@@ -2,7 +2,7 @@
 //! motion and the model bundle, and answers one input at a time with a [`Reply`]. It
 //! knows nothing of terminals, so tests drive it directly.
 //!
-//! Adding a command (the solver's `:run` will be one) means: a variant in
+//! Adding a command means: a variant in
 //! [`super::command::Command`] and its row in `COMMANDS`, and a method here that reads
 //! [`Session::program`], [`Session::motion`] and [`Session::bundle`] and hands a result to
 //! [`Session::set_motion`].
@@ -19,6 +19,7 @@ use crate::model::sampler::SamplerKind;
 use crate::motion::Motion;
 use crate::render::{RenderOptions, render_to_path};
 use crate::skeleton::FPS;
+use crate::solve::{Prior, SolveRequest, Solver, solve};
 use burn::tensor::Device;
 use std::path::{Path, PathBuf};
 
@@ -86,6 +87,11 @@ impl Session {
                 seconds,
                 seed,
             } => self.gen_motion(&prompt, seconds, seed),
+            Command::Run {
+                solver,
+                seed,
+                knobs,
+            } => self.run_program(&solver, seed, &knobs),
             Command::Eval(text) => probe::eval(self, &text),
             Command::Grad(text) => probe::grad(self, &text),
             Command::Score => probe::score(self),
@@ -267,6 +273,57 @@ impl Session {
                     )));
                 }
                 r
+            }
+        }
+    }
+
+    /// `:run`: the session's program solved with the model; the result becomes the current
+    /// motion and its per-statement errors are shown.
+    fn run_program(&mut self, name: &str, seed: u64, knobs: &[(String, f64)]) -> Reply {
+        let program = match self.program() {
+            Ok(p) => p,
+            Err(d) if !real_errors(&d) => {
+                return Reply::error(
+                    "the program is not complete yet: it needs `length` and at least one constraint",
+                );
+            }
+            Err(d) => return Reply::diagnostics(d),
+        };
+        let Some(mut solver) = Solver::by_name(name) else {
+            return Reply::error(format!(
+                "unknown solver `{name}`; use guide, latent, lbfgs, ik, ik-reg or plain"
+            ));
+        };
+        for (k, v) in knobs {
+            if let Err(e) = solver.set_knob(k, *v) {
+                return Reply::error(e);
+            }
+        }
+        let Some(prompts) = program.prompts().into_iter().collect::<Option<Vec<_>>>() else {
+            return Reply::error("every person needs a prompt: add `prompt \"…\"` to the program");
+        };
+        let req = SolveRequest::new(prompts, program.length(), seed, solver.clone());
+        let device = self.device.clone();
+        let error = |j: burn::tensor::Tensor<5>| program.evaluate(j).total;
+        let result = match self.bundle() {
+            Err(e) => return Reply::error(e),
+            Ok(bundle) => solve(&Prior::from_bundle(bundle), &req, &error, &device, |_| {}),
+        };
+        match result {
+            Err(e) => Reply::error(format!("{} failed: {e}", solver.name())),
+            Ok(r) => {
+                let seconds = r.seconds;
+                let people = r.motions.into_iter().next().unwrap_or_default();
+                self.set_motion(people, format!(":run {} seed {seed}", solver.name()));
+                let mut reply = Reply::text(format!(
+                    "{} in {seconds:.1} s; {}",
+                    solver.name(),
+                    self.describe_motion()
+                ));
+                for item in probe::score(self).items {
+                    reply.push(item);
+                }
+                reply
             }
         }
     }

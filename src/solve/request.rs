@@ -67,6 +67,104 @@ impl Solver {
         }
     }
 
+    /// The unguided sampler this solver starts from or steers (same chain and step count),
+    /// the fair baseline to compare it with.
+    pub fn unguided(&self) -> Solver {
+        Solver::Plain(match self {
+            Solver::Plain(k) => *k,
+            Solver::Guide(c) => SamplerKind::Ddpm(c.steps),
+            Solver::Lbfgs(c) => SamplerKind::Ddpm(c.steps),
+            Solver::Latent(c) => SamplerKind::Ddim(c.ddim_steps),
+            Solver::Ik(c) => c.sampler,
+        })
+    }
+
+    /// The knobs [`set_knob`](Self::set_knob) accepts for this solver.
+    pub fn knob_names(&self) -> &'static [&'static str] {
+        match self {
+            Solver::Plain(_) => &["steps"],
+            Solver::Guide(_) => &["steps", "k_early", "k_late", "late_steps", "tau"],
+            Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax"],
+            Solver::Ik(_) => &["ddim_steps", "iterations", "lr", "smoothness"],
+            Solver::Lbfgs(_) => &[
+                "steps",
+                "k_first",
+                "k_last",
+                "late_steps",
+                "history",
+                "max_iter",
+                "lr",
+            ],
+        }
+    }
+
+    /// Sets one numeric setting by name (`--knob iterations=30` on the command line).
+    /// Counts must be whole and positive; `relax` is 0 or 1. The solver's own check runs
+    /// when it starts, so out-of-range values are refused there with its message.
+    pub fn set_knob(&mut self, name: &str, value: f64) -> Result<(), String> {
+        let count = || -> Result<usize, String> {
+            if value.is_finite() && value >= 0.0 && value.fract() == 0.0 && value <= 1e7 {
+                Ok(value as usize)
+            } else {
+                Err(format!("`{name}` must be a whole number, not {value}"))
+            }
+        };
+        let real = || -> Result<f64, String> {
+            if value.is_finite() {
+                Ok(value)
+            } else {
+                Err(format!("`{name}` must be finite"))
+            }
+        };
+        let (solver, knobs) = (self.name(), self.knob_names().join(", "));
+        let unknown = || format!("solver `{solver}` has no knob `{name}`; it has: {knobs}");
+        match self {
+            Solver::Plain(SamplerKind::Ddim(n) | SamplerKind::Ddpm(n)) => match name {
+                "steps" => *n = count()?,
+                _ => return Err(unknown()),
+            },
+            Solver::Guide(c) => match name {
+                "steps" => c.steps = count()?,
+                "k_early" => c.k_early = count()?,
+                "k_late" => c.k_late = count()?,
+                "late_steps" => c.late_steps = count()?,
+                "tau" => c.tau = real()? as f32,
+                _ => return Err(unknown()),
+            },
+            Solver::Latent(c) => match name {
+                "ddim_steps" => c.ddim_steps = count()?,
+                "iterations" => c.iterations = count()?,
+                "lr" => c.lr = real()?,
+                "relax" => {
+                    c.relax = match count()? {
+                        0 => super::latent::Relax::None,
+                        1 => super::latent::Relax::RigidXz,
+                        _ => return Err("`relax` is 0 (off) or 1 (rigid XZ)".into()),
+                    }
+                }
+                _ => return Err(unknown()),
+            },
+            Solver::Ik(c) => match name {
+                "ddim_steps" => c.sampler = SamplerKind::Ddim(count()?),
+                "iterations" => c.iterations = count()?,
+                "lr" => c.lr = real()?,
+                "smoothness" => c.smoothness = real()? as f32,
+                _ => return Err(unknown()),
+            },
+            Solver::Lbfgs(c) => match name {
+                "steps" => c.steps = count()?,
+                "k_first" => c.k_first = count()?,
+                "k_last" => c.k_last = count()?,
+                "late_steps" => c.late_steps = count()?,
+                "history" => c.history = count()?,
+                "max_iter" => c.max_iter = count()?,
+                "lr" => c.lr = real()?,
+                _ => return Err(unknown()),
+            },
+        }
+        Ok(())
+    }
+
     /// The solver of that [`name`](Self::name) with its default settings.
     pub fn by_name(name: &str) -> Option<Solver> {
         Some(match name {

@@ -662,3 +662,32 @@ fn checkpointed_latent_gradient_matches_the_full_graph() {
         );
     }
 }
+
+#[test]
+fn knobs_set_settings_and_unknown_ones_list_the_valid_names() {
+    let mut latent = Solver::by_name("latent").unwrap();
+    latent.set_knob("iterations", 30.0).unwrap();
+    latent.set_knob("ddim_steps", 20.0).unwrap();
+    latent.set_knob("relax", 1.0).unwrap();
+    match &latent {
+        Solver::Latent(c) => {
+            assert_eq!((c.iterations, c.ddim_steps), (30, 20));
+            assert_eq!(c.relax, Relax::RigidXz);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(latent.unguided(), Solver::Plain(SamplerKind::Ddim(20)));
+    let err = latent.set_knob("k_late", 3.0).unwrap_err();
+    assert!(
+        err.contains("iterations") && err.contains("ddim_steps"),
+        "{err}"
+    );
+    assert!(latent.set_knob("iterations", 2.5).is_err());
+    assert!(latent.set_knob("lr", f64::NAN).is_err());
+    let mut guide = Solver::by_name("guide").unwrap();
+    guide.set_knob("steps", 100.0).unwrap();
+    assert_eq!(guide.unguided(), Solver::Plain(SamplerKind::Ddpm(100)));
+    let mut ik = Solver::by_name("ik").unwrap();
+    ik.set_knob("smoothness", 0.1).unwrap();
+    assert_eq!(ik.name(), "ik-reg");
+}

@@ -1,0 +1,112 @@
+//! Which burn device the command line computes on.
+//!
+//! Library code takes a `Device`; only the binary picks one. The default is burn's flex
+//! CPU backend. A build with the `cuda` or `wgpu` cargo feature can run the same code on
+//! a GPU by setting `MPROG_DEVICE=cuda` (or `wgpu`); asking for a backend the binary was
+//! built without is an error that says which feature to enable.
+
+use burn::prelude::Device;
+
+/// The environment variable that names the backend.
+pub const DEVICE_ENV: &str = "MPROG_DEVICE";
+
+/// The backends this binary was built with, by name.
+pub fn available() -> Vec<&'static str> {
+    let mut names = vec!["flex"];
+    if cfg!(feature = "cuda") {
+        names.push("cuda");
+    }
+    if cfg!(feature = "wgpu") {
+        names.push("wgpu");
+    }
+    if cfg!(feature = "ndarray") {
+        names.push("ndarray");
+    }
+    names
+}
+
+/// The device named by `name` (`flex`/`cpu`, `cuda`, `wgpu`, `ndarray`).
+pub fn device_named(name: &str) -> Result<Device, String> {
+    match name.trim().to_ascii_lowercase().as_str() {
+        "" | "flex" | "cpu" => Ok(Device::flex()),
+        #[cfg(feature = "cuda")]
+        "cuda" => Ok(Device::cuda(0)),
+        #[cfg(feature = "wgpu")]
+        "wgpu" => Ok(Device::wgpu(Default::default())),
+        #[cfg(feature = "ndarray")]
+        #[allow(deprecated)]
+        "ndarray" => Ok(Device::ndarray()),
+        other @ ("cuda" | "wgpu" | "ndarray") => Err(format!(
+            "{DEVICE_ENV}={other}, but this mprog was built without the `{other}` feature \
+             (rebuild with `cargo build --release --features {other}`); available: {}",
+            available().join(", ")
+        )),
+        other => Err(format!(
+            "{DEVICE_ENV}={other} is not a backend; available: {}",
+            available().join(", ")
+        )),
+    }
+}
+
+/// The device from `MPROG_DEVICE`, flex when unset.
+pub fn device_from_env() -> Result<Device, String> {
+    match std::env::var(DEVICE_ENV) {
+        Ok(name) => device_named(&name),
+        Err(_) => Ok(Device::flex()),
+    }
+}
+
+/// Name of the backend `MPROG_DEVICE` selects (`flex` when unset), for reports.
+pub fn backend_name() -> String {
+    std::env::var(DEVICE_ENV)
+        .map(|n| n.trim().to_ascii_lowercase())
+        .ok()
+        .filter(|n| !n.is_empty() && n != "cpu")
+        .unwrap_or_else(|| "flex".into())
+}
+
+/// One line about this machine: CPU model and logical cores, plus the GPU's name when
+/// `nvidia-smi` answers (best effort; for benchmark headers).
+pub fn machine_description() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let gpu = std::process::Command::new("nvidia-smi")
+        .args(["--query-gpu=name", "--format=csv,noheader"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .filter(|s| !s.is_empty());
+    match gpu {
+        Some(g) => format!("{cpu}, {cores} cores; GPU {g}"),
+        None => format!("{cpu}, {cores} cores"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flex_is_always_there_and_unknown_names_are_refused() {
+        assert!(device_named("flex").is_ok());
+        assert!(device_named(" CPU ").is_ok());
+        let err = device_named("tpu").unwrap_err();
+        assert!(
+            err.contains("not a backend") && err.contains("flex"),
+            "{err}"
+        );
+        if !cfg!(feature = "cuda") {
+            let err = device_named("cuda").unwrap_err();
+            assert!(err.contains("--features cuda"), "{err}");
+        }
+    }
+}

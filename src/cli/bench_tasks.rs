@@ -1,0 +1,273 @@
+//! `mprog bench tasks`: run the task suite ([`mprog::tasks`]) and write its markdown.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use miette::{IntoDiagnostic, Result, WrapErr, miette};
+use mprog::dataset::{Dataset, FEATURE_DIM, Split};
+use mprog::eval::evaluator::{Evaluator, default_evaluator_dir};
+use mprog::eval::scores::fid;
+use mprog::model::ModelBundle;
+use mprog::model::weights::default_model_dir;
+use mprog::solve::{Prior, Solver};
+use mprog::tasks::report::{Realism, RunInfo, markdown};
+use mprog::tasks::suite::{SuiteSize, Task, keyframe_suite, program_suite, solvers};
+use mprog::tasks::{RunRow, run_task};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `mprog bench tasks`.
+#[derive(clap::Args)]
+pub struct TaskBenchArgs {
+    /// A few tasks with short chains (minutes on a laptop CPU) instead of the whole suite
+    /// at the papers' settings.
+    #[arg(long)]
+    quick: bool,
+    /// Built dataset (`mprog data build`): test clips for keyframe control and the
+    /// realism reference. Without it those parts are skipped, with a message.
+    #[arg(long, default_value = "data/humanml")]
+    data: PathBuf,
+    /// Folder of the task programs.
+    #[arg(long, default_value = "programs")]
+    programs: PathBuf,
+    /// Samples per program task (full run).
+    #[arg(long, default_value_t = 4)]
+    samples: usize,
+    /// Test clips for keyframe control (full run).
+    #[arg(long, default_value_t = 4)]
+    clips: usize,
+    /// Only these solvers (comma separated: plain, guide, latent, ik, ik-reg, lbfgs).
+    #[arg(long, value_delimiter = ',')]
+    solvers: Vec<String>,
+    /// Override a solver setting for this run: `--knob latent.iterations=20`.
+    #[arg(long = "knob", value_parser = parse_knob)]
+    knobs: Vec<(String, String, f64)>,
+    /// Seed of every sample and of the keyframe draws.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Model bundle (default: the shipped model).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Write the markdown here (atomically) as well as to stdout.
+    #[arg(short, long)]
+    out: Option<PathBuf>,
+}
+
+fn parse_knob(s: &str) -> Result<(String, String, f64), String> {
+    let (key, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}`: expected solver.knob=value"))?;
+    let (solver, knob) = key
+        .split_once('.')
+        .ok_or_else(|| format!("`{key}`: expected solver.knob, e.g. latent.iterations"))?;
+    let value: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{value}` is not a number"))?;
+    Ok((solver.trim().into(), knob.trim().into(), value))
+}
+
+/// The solvers of this run, with `--solvers` and `--knob` applied.
+fn chosen_solvers(args: &TaskBenchArgs) -> Result<Vec<Solver>> {
+    let mut list = solvers(args.quick);
+    if !args.solvers.is_empty() {
+        for name in &args.solvers {
+            if Solver::by_name(name).is_none() {
+                return Err(miette!("unknown solver `{name}` in --solvers"));
+            }
+        }
+        list.retain(|s| args.solvers.iter().any(|n| n == s.name()));
+    }
+    for (solver, knob, value) in &args.knobs {
+        let mut hit = false;
+        for s in list.iter_mut().filter(|s| s.name() == solver) {
+            s.set_knob(knob, *value)
+                .map_err(|e| miette!("--knob {solver}.{knob}: {e}"))?;
+            hit = true;
+        }
+        if !hit {
+            return Err(miette!(
+                "--knob {solver}.{knob}: `{solver}` is not in this run"
+            ));
+        }
+    }
+    Ok(list)
+}
+
+/// UTC `YYYY-MM-DD HH:MM` of now (civil-from-days, proleptic Gregorian).
+fn utc_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs() as i64);
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02} {:02}:{:02} UTC",
+        rem / 3600,
+        rem % 3600 / 60
+    )
+}
+
+/// FID of each (family, solver)'s motions against test clips, when the data and the
+/// evaluator are there.
+fn realism(
+    rows: &[RunRow],
+    data: Option<&Dataset>,
+    device: &burn::prelude::Device,
+) -> Result<Realism> {
+    let mut out = Realism::new();
+    let Some(data) = data else { return Ok(out) };
+    let evaluator = match Evaluator::load(&default_evaluator_dir(), device) {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("realism column skipped: {e}");
+            return Ok(out);
+        }
+    };
+    let cap = evaluator.manifest.config.max_frames;
+    let reference: Vec<&[f32]> = data
+        .clips(Split::Test)
+        .filter(|c| c.frames >= 40)
+        .take(512)
+        .map(|c| &data.clip_features(c)[..c.frames.min(cap) * FEATURE_DIM])
+        .collect();
+    let reference = evaluator
+        .embed_motions(&reference, device)
+        .into_diagnostic()?;
+    let mut groups: std::collections::BTreeMap<_, Vec<&[f32]>> = Default::default();
+    for r in rows.iter().filter(|r| r.failure.is_none()) {
+        let g = groups.entry((r.family, r.solver.clone())).or_default();
+        g.extend(
+            r.features
+                .iter()
+                .map(|f| &f[..f.len().min(cap * FEATURE_DIM)]),
+        );
+    }
+    for (key, motions) in groups {
+        if motions.len() < 2 {
+            continue;
+        }
+        let emb = evaluator
+            .embed_motions(&motions, device)
+            .into_diagnostic()?;
+        if let Ok(score) = fid(&emb, &reference) {
+            out.insert(key, (score, motions.len()));
+        }
+    }
+    Ok(out)
+}
+
+/// Runs `mprog bench tasks`.
+pub fn run(args: TaskBenchArgs) -> Result<()> {
+    let started = Instant::now();
+    let device = super::device()?;
+    let list = chosen_solvers(&args)?;
+    let size = if args.quick {
+        SuiteSize::quick()
+    } else {
+        SuiteSize::full(args.samples.max(1), args.clips.max(1))
+    };
+    let dir = args.model.clone().unwrap_or_else(default_model_dir);
+    let bundle = ModelBundle::load(&dir, &device)
+        .into_diagnostic()
+        .wrap_err("cannot load the model")?;
+    let prior = Prior::from_bundle(&bundle);
+    let mut tasks: Vec<Task> = program_suite(&args.programs, &size).map_err(|e| miette!("{e}"))?;
+    let data = match Dataset::load(&args.data) {
+        Ok(d) => Some(d),
+        Err(e) => {
+            eprintln!(
+                "keyframe control and realism skipped: no dataset at {} ({e}); build it with `mprog data build`",
+                args.data.display()
+            );
+            None
+        }
+    };
+    if let Some(d) = &data {
+        tasks.extend(keyframe_suite(d, &size, args.seed).map_err(|e| miette!("{e}"))?);
+    }
+    let runs = tasks.len() * list.len();
+    eprintln!(
+        "{} tasks × {} solvers = {runs} runs on {}",
+        tasks.len(),
+        list.len(),
+        mprog::backend::backend_name()
+    );
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{prefix:>28} {bar:25} {pos}/{len} {msg} [{elapsed}]")
+            .expect("template"),
+    );
+    let mut rows = Vec::with_capacity(runs);
+    for task in &tasks {
+        for solver in &list {
+            bar.set_prefix(format!(
+                "{}/{runs} {} {}",
+                rows.len() + 1,
+                task.name,
+                solver.name()
+            ));
+            let row = run_task(&prior, task, solver, args.seed, &device, &mut |p| {
+                bar.set_length(p.total as u64);
+                bar.set_position(p.done as u64);
+                if let Some(e) = p.error {
+                    bar.set_message(format!("error {e:.4}"));
+                }
+            });
+            let line = if let Some(f) = &row.failure {
+                format!("{} / {}: failed: {f}", task.name, solver.name())
+            } else {
+                format!(
+                    "{:<28} {:<7} error {:.4}  unsuccess {:.2}  skating {:.3}  accel {:.3}  {:.1} s/sample",
+                    task.name,
+                    row.solver,
+                    row.error,
+                    row.unsuccess,
+                    row.skating,
+                    row.max_accel,
+                    row.seconds_per_sample
+                )
+            };
+            // A hidden bar (no terminal) drops its println: log plainly then.
+            if bar.is_hidden() {
+                eprintln!("{line}");
+            } else {
+                bar.println(line);
+            }
+            rows.push(row);
+        }
+    }
+    bar.finish_and_clear();
+    let realism = realism(&rows, data.as_ref(), &device)?;
+    let info = RunInfo {
+        date: utc_now(),
+        machine: mprog::backend::machine_description(),
+        backend: mprog::backend::backend_name(),
+        weights: format!(
+            "{} ({} training steps)",
+            bundle.manifest.weights_id, bundle.manifest.steps
+        ),
+        command: std::env::args()
+            .skip(1)
+            .collect::<Vec<_>>()
+            .join(" ")
+            .replace("bench tasks", "mprog bench tasks"),
+        solvers: list.iter().map(|s| format!("{s:?}")).collect(),
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    let md = markdown(&info, &rows, &realism);
+    print!("{md}");
+    if let Some(path) = &args.out {
+        mprog::fsutil::write_bytes_atomic(path, md.as_bytes())
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot write {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}

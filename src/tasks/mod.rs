@@ -1,0 +1,159 @@
+//! The task benchmark (`mprog bench tasks`): PMG's program tasks, OmniControl-style
+//! keyframe control on held-out test clips and InterControl-style two-person contacts,
+//! each solved by every solver and by the unguided model, and measured the same way.
+//!
+//! | stage | module | input → output |
+//! | --- | --- | --- |
+//! | which tasks and settings | [`suite`] | programs, test clips → [`suite::Task`]s, solvers |
+//! | keyframe targets, control metrics | [`keyframe`] | a test clip → batched goal; distances → [`keyframe::ControlErrors`] |
+//! | solving and measuring | this module | tasks × solvers → [`RunRow`]s |
+//! | the markdown | [`report`] | rows → tables |
+
+pub mod keyframe;
+pub mod report;
+pub mod suite;
+
+use crate::eval::metrics::{foot_skating_ratio, max_acceleration};
+use crate::features::FEATURE_DIM;
+use crate::motion::Motion;
+use crate::solve::{Prior, Progress, SolveRequest, Solver, solve};
+use burn::prelude::*;
+use keyframe::ControlErrors;
+use suite::{Family, Goal, Task};
+
+/// A statement (or keyframe) counts as missed when its error exceeds this (m, or the
+/// statement's own unit).
+pub const MISS_THRESHOLD: f32 = 0.05;
+
+/// What one (task, solver) run measured.
+#[derive(Clone, Debug)]
+pub struct RunRow {
+    /// Family.
+    pub family: Family,
+    /// Task name.
+    pub task: String,
+    /// Solver name.
+    pub solver: String,
+    /// Motions measured (samples × people).
+    pub motions: usize,
+    /// Mean constraint error (program total, or mean keyframe distance in m).
+    pub error: f32,
+    /// Fraction of samples with any statement (keyframe) missed by more than 5 cm.
+    pub unsuccess: f32,
+    /// OmniControl's metrics (keyframe tasks).
+    pub control: Option<ControlErrors>,
+    /// Mean foot-skating ratio.
+    pub skating: f32,
+    /// Mean of the per-motion maximum joint acceleration (m/frame²).
+    pub max_accel: f32,
+    /// Wall seconds per sample.
+    pub seconds_per_sample: f64,
+    /// Why the run failed (then the numbers are zero).
+    pub failure: Option<String>,
+    /// `[frames, 263]` de-normalised features of every motion, for the realism score.
+    pub features: Vec<Vec<f32>>,
+    /// Keyframe tasks: each cell's (joint, density label) and keyframe distances.
+    pub cells: Vec<(usize, String, Vec<f32>)>,
+}
+
+/// One solve of `task` with `solver`, measured.
+pub fn run_task(
+    prior: &Prior,
+    task: &Task,
+    solver: &Solver,
+    seed: u64,
+    device: &Device,
+    on_progress: &mut dyn FnMut(Progress),
+) -> RunRow {
+    let mut row = RunRow {
+        family: task.family,
+        task: task.name.clone(),
+        solver: solver.name().to_string(),
+        motions: 0,
+        error: 0.0,
+        unsuccess: 0.0,
+        control: None,
+        skating: 0.0,
+        max_accel: 0.0,
+        seconds_per_sample: 0.0,
+        failure: None,
+        features: Vec::new(),
+        cells: Vec::new(),
+    };
+    let req = SolveRequest {
+        samples: task.samples,
+        ..SolveRequest::new(task.prompts.clone(), task.frames, seed, solver.clone())
+    };
+    let error = |j: Tensor<5>| task.error(j);
+    let result = match solve(prior, &req, &error, device, on_progress) {
+        Ok(r) => r,
+        Err(e) => {
+            row.failure = Some(e.to_string());
+            return row;
+        }
+    };
+    let all: Vec<&Motion> = result.motions.iter().flatten().collect();
+    row.motions = all.len();
+    row.skating = mean(all.iter().map(|m| foot_skating_ratio(m)));
+    row.max_accel = mean(all.iter().map(|m| max_acceleration(m)));
+    row.seconds_per_sample = result.seconds / task.samples.max(1) as f64;
+    let per_motion = task.frames * FEATURE_DIM;
+    row.features = result
+        .features
+        .chunks_exact(per_motion)
+        .map(<[f32]>::to_vec)
+        .collect();
+    match &task.goal {
+        Goal::Program(program) => {
+            let joints = world_tensor(&result.motions, device);
+            let e = program.evaluate(joints);
+            let totals = e
+                .total
+                .into_data()
+                .try_into_vec::<f32>()
+                .unwrap_or_default();
+            let per = e
+                .per_statement
+                .into_data()
+                .try_into_vec::<f32>()
+                .unwrap_or_default();
+            let statements = per.len() / totals.len().max(1);
+            row.error = mean(totals.iter().copied());
+            row.unsuccess = mean(
+                per.chunks(statements.max(1))
+                    .map(|s| f32::from(s.iter().any(|&v| v > MISS_THRESHOLD))),
+            );
+        }
+        Goal::Keyframes(goal) => {
+            let firsts: Vec<Motion> = result.motions.iter().map(|p| p[0].clone()).collect();
+            let distances = goal.distances(&firsts);
+            let c = ControlErrors::of(&distances);
+            row.error = c.avg;
+            row.unsuccess = c.unsuccess;
+            row.control = Some(c);
+            row.cells = goal
+                .cells
+                .iter()
+                .zip(distances)
+                .map(|(cell, d)| (cell.joint, cell.density.label(), d))
+                .collect();
+        }
+    }
+    row
+}
+
+/// `[B, P, N, 22, 3]` of solved motions.
+fn world_tensor(motions: &[Vec<Motion>], device: &Device) -> Tensor<5> {
+    let (b, p) = (motions.len(), motions.first().map_or(0, Vec::len));
+    let n = motions.iter().flatten().map(Motion::len).min().unwrap_or(0);
+    let mut flat = Vec::with_capacity(b * p * n * 66);
+    for m in motions.iter().flatten() {
+        flat.extend_from_slice(&m.to_flat()[..n * 66]);
+    }
+    Tensor::from_data(TensorData::new(flat, [b, p, n, 22, 3]), device)
+}
+
+fn mean(values: impl Iterator<Item = f32>) -> f32 {
+    let (s, n) = values.fold((0.0f64, 0usize), |(s, n), v| (s + v as f64, n + 1));
+    if n == 0 { 0.0 } else { (s / n as f64) as f32 }
+}

@@ -1,0 +1,251 @@
+//! What the benchmark runs: the tasks of each family and the solvers with their settings.
+
+use super::keyframe::{CONTROLLED, Density, KeyframeGoal};
+use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
+use crate::lang::Program;
+use crate::model::sampler::SamplerKind;
+use crate::solve::{GuideConfig, IkConfig, LatentConfig, LbfgsConfig, Solver};
+use burn::prelude::*;
+use std::path::Path;
+
+/// The three task families of the benchmark.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Family {
+    /// PMG's program tasks (`programs/`).
+    Pmg,
+    /// OmniControl-style keyframe control on held-out test clips.
+    Keyframe,
+    /// InterControl-style contacts between two people (`programs/ic_*`).
+    Contact,
+}
+
+impl Family {
+    /// Heading of the family's section.
+    pub fn title(self) -> &'static str {
+        match self {
+            Family::Pmg => "PMG tasks",
+            Family::Keyframe => "Keyframe control (OmniControl)",
+            Family::Contact => "Two-person contact (InterControl)",
+        }
+    }
+}
+
+/// What a task's error measures.
+pub enum Goal {
+    /// A `.mprog` program (its total error).
+    Program(Box<Program>),
+    /// Keyframes of a test clip, one cell per sample.
+    Keyframes(KeyframeGoal),
+}
+
+/// One task: prompts, length, goal.
+pub struct Task {
+    /// Family.
+    pub family: Family,
+    /// Name in the tables (`HSC-1`, a clip name).
+    pub name: String,
+    /// One prompt per person.
+    pub prompts: Vec<String>,
+    /// Frames per motion.
+    pub frames: usize,
+    /// Samples solved side by side (keyframe tasks: one per cell).
+    pub samples: usize,
+    /// The goal.
+    pub goal: Goal,
+}
+
+impl Task {
+    /// `[B]` error of joints `[B, P, N, 22, 3]`.
+    pub fn error(&self, joints: Tensor<5>) -> Tensor<1> {
+        match &self.goal {
+            Goal::Program(p) => p.evaluate(joints).total,
+            Goal::Keyframes(k) => k.error(joints),
+        }
+    }
+}
+
+/// PMG's tasks as (name, file in `programs/`); the quick run keeps the first three.
+pub const PMG_PROGRAMS: [(&str, &str); 12] = [
+    ("HSC-1", "hsc1_hand_on_head.mprog"),
+    ("HSI-3", "hsi3_square.mprog"),
+    ("HOD-1", "hod1_velocity.mprog"),
+    ("HSI-1", "hsi1_head_height.mprog"),
+    ("HSI-2", "hsi2_barrier.mprog"),
+    ("HSI-4", "hsi4_overhead_barrier.mprog"),
+    ("HSI-5", "hsi5_narrow_gap.mprog"),
+    ("GEO-1", "geo1_hand_on_wall.mprog"),
+    ("GEO-2", "geo2_balance_beam.mprog"),
+    ("HOI-1", "hoi1_move_object.mprog"),
+    ("HOI-2", "hoi2_carry_ball.mprog"),
+    ("PBG-1", "pbg1_one_leg_balance.mprog"),
+];
+
+/// InterControl's two-person tasks; the quick run keeps the first.
+pub const CONTACT_PROGRAMS: [(&str, &str); 2] = [
+    ("handshake", "ic_handshake.mprog"),
+    ("dance holding hands", "ic_dance_holding_hands.mprog"),
+];
+
+/// How big a run is.
+#[derive(Clone, Debug)]
+pub struct SuiteSize {
+    /// The quick subset and settings.
+    pub quick: bool,
+    /// Samples per program task.
+    pub samples: usize,
+    /// Test clips for keyframe control.
+    pub clips: usize,
+    /// Frames of a keyframe-control motion (clips shorter than this are not used).
+    pub keyframe_frames: usize,
+}
+
+impl SuiteSize {
+    /// `--quick`: 3 PMG tasks, 1 contact task, 1 clip × 2 joints × 2 densities, 60 frames.
+    pub fn quick() -> Self {
+        SuiteSize {
+            quick: true,
+            samples: 1,
+            clips: 1,
+            keyframe_frames: 60,
+        }
+    }
+
+    /// Every task: 12 PMG tasks, 2 contact tasks, 6 joints × 5 densities per clip.
+    pub fn full(samples: usize, clips: usize) -> Self {
+        SuiteSize {
+            quick: false,
+            samples,
+            clips,
+            keyframe_frames: 120,
+        }
+    }
+}
+
+fn program_tasks(
+    dir: &Path,
+    list: &[(&str, &str)],
+    family: Family,
+    samples: usize,
+) -> Result<Vec<Task>, String> {
+    list.iter()
+        .map(|(name, file)| {
+            let path = dir.join(file);
+            let source =
+                std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let program =
+                crate::lang::compile(&source, &path.display().to_string(), &[]).map_err(|d| {
+                    format!("{} does not compile:\n{}", path.display(), d.render_plain())
+                })?;
+            let prompts = program
+                .prompts()
+                .into_iter()
+                .collect::<Option<Vec<_>>>()
+                .ok_or_else(|| format!("{} has a person without a prompt", path.display()))?;
+            Ok(Task {
+                family,
+                name: name.to_string(),
+                prompts,
+                frames: program.length(),
+                samples,
+                goal: Goal::Program(Box::new(program)),
+            })
+        })
+        .collect()
+}
+
+/// The PMG and contact tasks from the programs in `dir`.
+pub fn program_suite(dir: &Path, size: &SuiteSize) -> Result<Vec<Task>, String> {
+    let (pmg, contact) = if size.quick {
+        (&PMG_PROGRAMS[..3], &CONTACT_PROGRAMS[..1])
+    } else {
+        (&PMG_PROGRAMS[..], &CONTACT_PROGRAMS[..])
+    };
+    let mut tasks = program_tasks(dir, pmg, Family::Pmg, size.samples)?;
+    tasks.extend(program_tasks(dir, contact, Family::Contact, size.samples)?);
+    Ok(tasks)
+}
+
+/// Test clips for keyframe control: not mirrored, long enough, spread evenly over the
+/// split's name order so different actions come up.
+pub fn keyframe_clips<'a>(data: &'a Dataset, size: &SuiteSize) -> Vec<&'a ClipInfo> {
+    let mut eligible: Vec<&ClipInfo> = data
+        .clips(Split::Test)
+        .filter(|c| !c.mirrored && c.frames >= size.keyframe_frames && !c.captions.is_empty())
+        .collect();
+    eligible.sort_by(|a, b| a.name.cmp(&b.name));
+    let k = size.clips.min(eligible.len());
+    (0..k).map(|i| eligible[i * eligible.len() / k]).collect()
+}
+
+/// Keyframe-control tasks on test clips of `data`.
+pub fn keyframe_suite(data: &Dataset, size: &SuiteSize, seed: u64) -> Result<Vec<Task>, String> {
+    let (joints, densities): (Vec<usize>, Vec<Density>) = if size.quick {
+        (
+            vec![0, 20],
+            vec![Density::Frames(1), Density::Fraction(0.25)],
+        )
+    } else {
+        (
+            CONTROLLED.iter().map(|c| c.0).collect(),
+            Density::ALL.to_vec(),
+        )
+    };
+    keyframe_clips(data, size)
+        .into_iter()
+        .enumerate()
+        .map(|(i, clip)| {
+            let n = size.keyframe_frames;
+            let features = &data.clip_features(clip)[..n * FEATURE_DIM];
+            let goal = KeyframeGoal::new(features, &joints, &densities, seed ^ (i as u64) << 16)
+                .map_err(|e| format!("test clip {}: {e}", clip.name))?;
+            Ok(Task {
+                family: Family::Keyframe,
+                name: clip.name.clone(),
+                prompts: vec![clip.captions[0].clone()],
+                frames: n,
+                samples: goal.cells.len(),
+                goal: Goal::Keyframes(goal),
+            })
+        })
+        .collect()
+}
+
+/// The solvers compared, with the benchmark's settings: the papers' defaults in a full
+/// run; in a quick run, shorter chains and fewer iterations so it ends in minutes.
+pub fn solvers(quick: bool) -> Vec<Solver> {
+    if !quick {
+        return ["plain", "guide", "latent", "ik", "ik-reg", "lbfgs"]
+            .iter()
+            .map(|n| Solver::by_name(n).expect("known solver"))
+            .collect();
+    }
+    let ik = IkConfig {
+        sampler: SamplerKind::Ddim(10),
+        iterations: 30,
+        ..IkConfig::ik()
+    };
+    vec![
+        Solver::Plain(SamplerKind::Ddpm(100)),
+        Solver::Guide(GuideConfig {
+            steps: 100,
+            k_late: 50,
+            late_steps: 5,
+            ..GuideConfig::default()
+        }),
+        Solver::Latent(LatentConfig {
+            ddim_steps: 10,
+            iterations: 10,
+            lr: 0.02,
+            ..LatentConfig::default()
+        }),
+        Solver::Ik(ik.clone()),
+        Solver::Ik(IkConfig {
+            smoothness: IkConfig::ik_reg().smoothness,
+            ..ik
+        }),
+        Solver::Lbfgs(LbfgsConfig {
+            steps: 100,
+            ..LbfgsConfig::default()
+        }),
+    ]
+}

@@ -1,0 +1,145 @@
+//! `mprog run` and `mprog bench tasks` through the built binary, with the shipped model and
+//! short chains: solver knobs, the warning for statements the unguided motion already
+//! satisfies, and what is saved next to the output.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The binary under test: cargo's, or `$MPROG_TEST_BIN` (see `tests/adversarial.rs`).
+fn bin() -> Command {
+    let bin = std::env::var_os("MPROG_TEST_BIN")
+        .map_or_else(|| env!("CARGO_BIN_EXE_mprog").into(), PathBuf::from);
+    let mut c = Command::new(bin);
+    c.env("NO_COLOR", "1")
+        .env_remove("MPROG_DEVICE")
+        .current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().unwrap()
+}
+
+fn text(out: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+fn program(dir: &Path, body: &str) -> String {
+    let p = dir.join("p.mprog");
+    std::fs::write(&p, body).unwrap();
+    p.display().to_string()
+}
+
+#[test]
+fn knobs_reach_the_solver_and_the_saved_meta() {
+    let dir = tempfile::tempdir().unwrap();
+    let prog = program(
+        dir.path(),
+        "prompt \"a person walks forward\"\nlength 1s\nhead.y > -5 m\nat end { pelvis.z > 5 m }\n",
+    );
+    let json = dir.path().join("out.json");
+    let out = run(&[
+        "run",
+        &prog,
+        "--solver",
+        "guide",
+        "--knob",
+        "steps=10",
+        "--knob",
+        "k_late=20",
+        "--knob",
+        "late_steps=2",
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("| **total** |"), "{stdout}");
+    assert!(
+        stderr.contains("line 3: already satisfied on every frame by the unguided motion"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("line 4: already"), "{stderr}");
+    let meta = std::fs::read_to_string(&json).unwrap();
+    assert!(
+        meta.contains("\"knobs\"") && meta.contains("k_late"),
+        "{meta}"
+    );
+    assert!(
+        meta.contains("steps: 10"),
+        "the solver's settings are saved: {meta}"
+    );
+
+    let out = run(&[
+        "run",
+        &prog,
+        "--solver",
+        "latent",
+        "--knob",
+        "k_late=3",
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("no knob `k_late`") && stderr.contains("iterations"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn quick_task_bench_writes_a_table_for_the_chosen_solvers() {
+    let dir = tempfile::tempdir().unwrap();
+    let md = dir.path().join("tasks.md");
+    let out = run(&[
+        "bench",
+        "tasks",
+        "--quick",
+        "--solvers",
+        "plain,guide",
+        "--knob",
+        "guide.steps=10",
+        "--knob",
+        "guide.k_late=10",
+        "--knob",
+        "plain.steps=10",
+        "--data",
+        "/nonexistent",
+        "-o",
+        md.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("keyframe control and realism skipped"),
+        "{stderr}"
+    );
+    let table = std::fs::read_to_string(&md).unwrap();
+    assert_eq!(table, stdout);
+    for needle in [
+        "## PMG tasks",
+        "## Two-person contact",
+        "| guide |",
+        "| plain |",
+        "HSC-1",
+        "handshake",
+    ] {
+        assert!(table.contains(needle), "{needle} missing:\n{table}");
+    }
+    assert!(!table.contains("| latent |"));
+    let out = run(&[
+        "bench",
+        "tasks",
+        "--quick",
+        "--solvers",
+        "guide",
+        "--knob",
+        "latent.iterations=3",
+    ]);
+    assert!(!out.status.success());
+    assert!(text(&out).1.contains("not in this run"));
+}
