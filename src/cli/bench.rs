@@ -19,6 +19,9 @@ pub enum BenchCommand {
     /// The task suite: every solver on PMG's tasks, keyframe control of test clips and
     /// two-person contacts; writes a markdown table.
     Tasks(super::bench_tasks::TaskBenchArgs),
+    /// What steering costs: each solver at the papers' defaults on one program next to its
+    /// unguided sampler (time ratios, latent seconds per motion).
+    Solvers(super::bench_solvers::SolverBenchArgs),
 }
 
 /// Arguments of `mprog bench model`.
@@ -41,6 +44,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
         BenchCommand::Model(args) => bench_model(args),
         BenchCommand::Tasks(args) => super::bench_tasks::run(args),
+        BenchCommand::Solvers(args) => super::bench_solvers::run(args),
     }
 }
 

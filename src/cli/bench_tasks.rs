@@ -9,7 +9,9 @@ use mprog::model::ModelBundle;
 use mprog::model::weights::default_model_dir;
 use mprog::solve::{Prior, Solver};
 use mprog::tasks::report::{Realism, RunInfo, markdown};
-use mprog::tasks::suite::{SuiteSize, Task, keyframe_suite, program_suite, solvers};
+use mprog::tasks::suite::{
+    SolverSettings, SuiteSize, Task, keyframe_suite, program_suite, solvers,
+};
 use mprog::tasks::{RunRow, run_task};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -17,10 +19,12 @@ use std::time::Instant;
 /// Arguments of `mprog bench tasks`.
 #[derive(clap::Args)]
 pub struct TaskBenchArgs {
-    /// A few tasks with short chains (minutes on a laptop CPU) instead of the whole suite
-    /// at the papers' settings.
+    /// A few tasks (minutes on a laptop CPU) instead of the whole suite.
     #[arg(long)]
     quick: bool,
+    /// Chain lengths: `fast` (sized for a CPU) or `paper` (the papers' defaults, for a GPU).
+    #[arg(long, value_enum, default_value = "fast")]
+    settings: SolverSettings,
     /// Built dataset (`mprog data build`): test clips for keyframe control and the
     /// realism reference. Without it those parts are skipped, with a message.
     #[arg(long, default_value = "data/humanml")]
@@ -67,7 +71,7 @@ fn parse_knob(s: &str) -> Result<(String, String, f64), String> {
 
 /// The solvers of this run, with `--solvers` and `--knob` applied.
 fn chosen_solvers(args: &TaskBenchArgs) -> Result<Vec<Solver>> {
-    let mut list = solvers(args.quick);
+    let mut list = solvers(args.settings);
     if !args.solvers.is_empty() {
         for name in &args.solvers {
             if Solver::by_name(name).is_none() {

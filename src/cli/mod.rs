@@ -1,6 +1,7 @@
 //! Subcommands of the `mprog` binary, one file each.
 
 pub mod bench;
+pub mod bench_solvers;
 pub mod bench_tasks;
 pub mod check;
 pub mod convert;

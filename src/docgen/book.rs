@@ -74,11 +74,22 @@ fn first_sentence(prose: &str) -> String {
     prose[..end].trim().trim_end_matches('.').to_string()
 }
 
-/// Where `scripts/cookbook-renders.sh` puts each program's rendered result.
-pub fn render_path(book_src: &Path, p: &ProgramFile) -> PathBuf {
+/// The solver runs `scripts/cookbook-renders.sh` makes for every program: (file suffix,
+/// solver, extra `mprog run` arguments).
+pub const COOKBOOK_RENDERS: [(&str, &str, &str); 2] = [
+    ("", "guide", ""),
+    (
+        "-latent",
+        "latent",
+        " --knob ddim_steps=10 --knob iterations=30 --knob lr=0.02",
+    ),
+];
+
+/// Where `scripts/cookbook-renders.sh` puts a program's result with the solver of `suffix`.
+pub fn render_path(book_src: &Path, p: &ProgramFile, suffix: &str) -> PathBuf {
     book_src
         .join("images/cookbook")
-        .join(format!("{}.png", p.file.trim_end_matches(".mprog")))
+        .join(format!("{}{suffix}.png", p.file.trim_end_matches(".mprog")))
 }
 
 fn cookbook_page(p: &ProgramFile, book_src: &Path) -> String {
@@ -97,16 +108,21 @@ fn cookbook_page(p: &ProgramFile, book_src: &Path) -> String {
         "```mprog\n{{{{#include ../../../programs/{}}}}}\n```\n\n",
         p.file
     ));
-    if render_path(book_src, p).exists() {
+    for (suffix, solver, extra) in COOKBOOK_RENDERS {
+        let png = render_path(book_src, p, suffix);
+        if !png.exists() {
+            continue;
+        }
         s.push_str(&format!(
-            "![{stem} solved with guide](../images/cookbook/{stem}.png)\n\n\
-             *`mprog run programs/{0} --solver guide --seed 1 -o {stem}.png` with the shipped \
-             weights (made by `scripts/cookbook-renders.sh`).*\n\n",
+            "## Solved with `{solver}`\n\n\
+             ![{stem} solved with {solver}](../images/cookbook/{stem}{suffix}.png)\n\n\
+             *`mprog run programs/{0} --solver {solver}{extra} --seed 1 -o {stem}{suffix}.png` \
+             with the shipped weights (made by `scripts/cookbook-renders.sh`).*\n\n",
             p.file
         ));
-        if render_path(book_src, p).with_extension("md").exists() {
+        if png.with_extension("md").exists() {
             s.push_str(&format!(
-                "Error of each statement, unguided and guided:\n\n{{{{#include ../images/cookbook/{stem}.md}}}}\n\n"
+                "Error of each statement, unguided and solved:\n\n{{{{#include ../images/cookbook/{stem}{suffix}.md}}}}\n\n"
             ));
         }
     }

@@ -39,13 +39,30 @@ pub fn signature_lines() -> Vec<String> {
         .iter()
         .map(|b| format!("{} — {}", b.signature, b.doc))
         .collect();
-    out.extend(
-        stdlib::docs()
-            .iter()
-            .map(|d| format!("{} — {}", d.signature, description(&d.doc))),
-    );
+    out.extend(stdlib::docs().iter().map(|d| {
+        let kind = if CONSTRAINT_FUNCTIONS.contains(&d.name.as_str()) {
+            "**constraint.** "
+        } else {
+            ""
+        };
+        format!("{} — {kind}{}", d.signature, description(&d.doc))
+    }));
     out
 }
+
+/// Library functions whose result is a constraint (a statement), not a value; the prompt
+/// card marks them. A test checks each is refused in arithmetic and the others are not.
+pub const CONSTRAINT_FUNCTIONS: [&str; 9] = [
+    "inBox",
+    "inSquare",
+    "boneDir",
+    "balanced",
+    "contact",
+    "apart",
+    "separation",
+    "faceToFace",
+    "noTorsoCollision",
+];
 
 fn lib_item(d: &LibDoc) -> String {
     let mut s = format!("### `{}`\n\n{}\n", d.signature, description(&d.doc));
@@ -84,4 +101,54 @@ pub fn stdlib_reference() -> String {
         }
     }
     s.trim_end().to_string() + "\n"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `name(…)` as written in `example`, parentheses matched.
+    fn call_in(example: &str, name: &str) -> Option<String> {
+        let start = example.find(&format!("{name}("))?;
+        let mut depth = 0;
+        for (i, c) in example[start..].char_indices() {
+            match c {
+                '(' => depth += 1,
+                ')' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        return Some(example[start..=start + i].to_string());
+                    }
+                }
+                _ => {}
+            }
+        }
+        None
+    }
+
+    #[test]
+    fn constraint_functions_are_exactly_the_ones_and_accepts() {
+        let mut checked = 0;
+        for d in stdlib::docs() {
+            let Some(ex) = example(&d.doc) else { continue };
+            let Some(call) = call_in(&ex, &d.name) else {
+                continue;
+            };
+            // `and` takes constraints only: in the example's own context (loops, people).
+            let program = example_program(&ex.replacen(&call, &format!("({call} and {call})"), 1));
+            let is_constraint = !check_source(&program, "probe", &[]).has_errors();
+            assert_eq!(
+                is_constraint,
+                CONSTRAINT_FUNCTIONS.contains(&d.name.as_str()),
+                "{}: `{call}` {} a constraint",
+                d.name,
+                if is_constraint { "is" } else { "is not" }
+            );
+            checked += 1;
+        }
+        assert!(checked >= 15, "only {checked} library functions probed");
+        for name in CONSTRAINT_FUNCTIONS {
+            assert!(stdlib::docs().iter().any(|d| d.name == name), "{name}");
+        }
+    }
 }

@@ -5,7 +5,7 @@
 //! each ```` ```mprog ```` block of the prompt.
 
 use super::library::signature_lines;
-use crate::skeleton::{ALIASES, JOINT_NAMES, rest_pose};
+use crate::skeleton::{ALIASES, JOINT_NAMES};
 
 /// Worked examples: (task, program). None of these tasks is in `programs/`.
 pub const EXAMPLES: &[(&str, &str)] = &[
@@ -72,10 +72,23 @@ always { separation(a, b, 0.4 m) }
     ),
 ];
 
+/// Joint heights (m) of a real person standing upright: frame 110 of HumanML3D clip
+/// 012314 (`tests/fixtures/humanml3d/new_joints_012314.npy`), left and right averaged.
+/// HumanML3D's raw rest offsets are IK directions, not a standing pose (the head points
+/// forward, the arms hang from the collars), so they would mislead; a test checks these
+/// against the fixture.
+pub const STANDING_HEIGHTS: [f32; 22] = [
+    0.92, 0.84, 0.84, 1.05, 0.48, 0.48, 1.19, 0.07, 0.07, 1.22, 0.03, 0.03, 1.43, 1.34, 1.34, 1.48,
+    1.34, 1.34, 1.08, 1.08, 0.88, 0.88,
+];
+
+/// Frame of the fixture the heights come from.
+pub const STANDING_FRAME: usize = 110;
+
 fn joints_section() -> String {
-    let rest = rest_pose();
-    let mut s =
-        String::from("| index | joint | aliases | rest height (m) |\n| --- | --- | --- | --- |\n");
+    let mut s = String::from(
+        "| index | joint | aliases | height standing (m) |\n| --- | --- | --- | --- |\n",
+    );
     for (i, name) in JOINT_NAMES.iter().enumerate() {
         let aliases: Vec<String> = ALIASES
             .iter()
@@ -85,11 +98,28 @@ fn joints_section() -> String {
         s.push_str(&format!(
             "| {i} | `{name}` | {} | {:.2} |\n",
             aliases.join(", "),
-            rest[i].y
+            STANDING_HEIGHTS[i]
         ));
     }
+    s.push_str(BODY_NOTES);
     s
 }
+
+const BODY_NOTES: &str = r#"
+Joints are points inside the body, not its surface:
+- `head` is the centre of the head; its top is about 12 cm higher, the face about 10 cm
+  in front. A ceiling at height h needs `head.y < h - 12 cm`.
+- `l_hand`/`r_hand` are the **wrists**; the palm is about 8 cm and the fingertips about
+  18 cm further along the forearm. "Hand on the floor" is about `r_hand.y < 10 cm`;
+  "hand touching a surface" is about `distToPlane(r_hand, …) < 8 cm`.
+- `l_foot`/`r_foot` are the balls of the feet (toe joints), `l_ankle`/`r_ankle` the
+  ankles. A planted foot has its toe joint below 5 cm and its ankle below 10 cm;
+  `footHeight(me)` is the lowest of the four.
+- `chest` (`spine3`) is the upper back / chest joint, `spine2` the middle of the back,
+  `spine` (`spine1`) the lower back. The torso is about 20 cm deep front to back and 35 cm
+  wide at the shoulders: a hand resting on someone's chest or back is about 10–12 cm
+  from their `chest` joint.
+"#;
 
 /// The full system prompt, in markdown.
 pub fn system_prompt() -> String {
@@ -124,9 +154,16 @@ with one complete program in a ```mprog code block, and nothing the language lac
 
 - Skeleton: HumanML3D, 22 joints (table below). Positions are in metres, **Y is up**, the
   ground is y = 0. 20 frames per second; a motion is at most 196 frames (9.8 s).
-- At frame 0 the person stands near the origin **facing +Z; their left is +X**, their
-  right is −X. "Forward" is +Z, "backward" −Z, "to the left" +X.
-- A standing adult: pelvis ≈ 0.95 m, head ≈ 1.6 m high (rest heights in the table).
+- At frame 0 the person stands with the pelvis **at x = z = 0, facing +Z; their left is
+  +X**, their right is −X. "Forward" is +Z, "backward" −Z, "to the left" +X. The solvers
+  keep that start (only `latent` with `relax` may shift the whole motion), so a
+  constraint on where the person is at frame 0 cannot be met: write places relative to
+  the start (`pelvis@start + [0, 0, 3]`) or make the start part of the region.
+- Two people: `a` starts at the origin facing +Z, `b` at (0, 0, 2) facing −Z (2 m apart,
+  face to face). Three or more: on a circle around its centre, neighbours 2 m apart, all
+  facing the centre, the first at the origin facing +Z.
+- The person is about 1.6 m tall: pelvis ≈ 0.92 m, head joint ≈ 1.48 m when standing
+  (table below). Arms are about 0.6 m long (shoulder to wrist), legs about 0.85 m.
 
 ## The language in brief
 
@@ -151,9 +188,22 @@ minimize norm(acc(r_hand))             # any scalar
 - Numbers take units `m cm mm s ms frames deg rad`; a bare number takes the unit of what
   it meets (`head.y > 1.2` is metres). Vectors `[x, y, z]`; components `.x .y .z`;
   `.xz` is the ground projection (y set to 0). Arithmetic `+ - * /` is unit-checked.
+- Vector parts may carry units (`[0, 60 cm, 0.5 m]`); bare parts take the unit of what
+  the vector meets (metres next to a position). A unit after the bracket is an error.
 - `e@t` is `e` at frame t: `head@0`, `pelvis@start`, `pelvis@end`, `l_hand@2s`,
-  `pelvis@50%`, `head@(end - 1)`. Times: a bare number is a frame index; `2s`, `40 frames`,
-  `50%` (of the last frame), `start`, `mid`, `end`, and sums/scalings of them.
+  `pelvis@50%`, `head@(end - 1)`. `@` binds tighter than everything else:
+  `pelvis@start + [0, 0, 3]` is `(pelvis@start) + [0, 0, 3]`, `pelvis@start.z` is
+  `(pelvis@start).z`. Times: a bare number is a frame index; `2s`, `40 frames`, `50%`,
+  `start` (frame 0), `mid`, `end` (the last frame), and sums/scalings of them. With F
+  frames a time position is the frame round(fraction·(F − 1)) (plus its frames): `mid`
+  is frame round((F − 1)/2), `50%` the same. `length 4s` is 80 frames, 0…79, so `at 4s`
+  is out of range: use `end`.
+- `during a..b` covers frames a ≤ t < b (`during 2s..end` leaves out the last frame;
+  `during 2s..end + 1` includes it). Blocks nest and intersect: `at end { weight 2 { … } }`,
+  `for f in feet { always { … } }` and `at end weight 2 { … }` are all fine.
+- Functions may take people: `def hold(p, q) = dist(p.r_hand, q.l_hand) < 10 cm`;
+  `for p in people { … }` loops over every person and `for j in [head, neck]` or
+  `for h in hands` over joints.
 - Several people: `people a "prompt of a", b "prompt of b"` replaces `prompt`; joints are
   then qualified (`a.r_hand`, `b.head`) and functions taking a person get `a`/`b`. With
   one person the person is called `me`.
@@ -172,10 +222,17 @@ const SEMANTICS: &str = r#"
 | `not c` | −E |
 | `minimize e` / `maximize e` | e / −e |
 
+Library functions marked **constraint** in the list above (`inBox`, `inSquare`, `boneDir`,
+`balanced`, `contact`, `apart`, `separation`, `faceToFace`, `noTorsoCollision`) are
+constraints: use them as statements or with `and`/`or`/`not`, never in arithmetic. Every
+other function returns a number, a point or a vector that you compare yourself.
+
 Each statement's error is averaged over the frames of its block (and, inside `if`, only
 over the frames where the condition holds), multiplied by its weight; the program's total
 is the sum over statements. Errors are in the constraint's unit: metres for distances,
-m/s for `vel`, radians for angles. So a total of 0.05 means "about 5 cm off on average";
+m/s for `vel`, radians for angles (`boneDir`, `faceToFace`: radians of the angle off;
+`balanced`, `contact`, `apart`, `separation`, `noTorsoCollision`, `inBox`, `inSquare`:
+metres). So a total of 0.05 means "about 5 cm off on average";
 0 means every constraint holds. Inside an `if` condition a comparison is a yes/no test
 per frame (no gradient flows through it); `==` is not allowed there.
 "#;
@@ -198,7 +255,41 @@ const RULES: &str = r#"
    targets reachable: arms are about 0.6 m long, a step is about 0.7 m, walking speed is
    about 1.3 m/s.
 8. Units must agree: do not compare a distance with a time or an angle.
-9. If mprog answers with diagnostics (JSON from `mprog check --format json`), fix exactly
+9. The error is pushed just to the threshold, not past it: when a limit must really hold
+   (a wall, a ceiling, a radius), leave a few centimetres of margin in the number.
+10. Constrain what the words ask and no more: every extra constraint fights the model's
+    natural motion. Let the prompt carry the style ("crouches", "kicks high").
+11. If mprog answers with diagnostics (JSON from `mprog check --format json`), fix exactly
    the reported problems (each has a code, a line, a message and a hint) and answer with
    the whole corrected program.
 "#;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn standing_heights_are_those_of_the_real_clip() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/fixtures/humanml3d/new_joints_012314.npy"
+        );
+        let array = crate::formats::npy::read_npy(std::path::Path::new(path)).unwrap();
+        let height = |j: usize| array.data[(STANDING_FRAME * 22 + j) * 3 + 1];
+        for (j, &h) in STANDING_HEIGHTS.iter().enumerate() {
+            let mirror = crate::skeleton::mirror_joint(j);
+            let real = (height(j) + height(mirror)) / 2.0;
+            assert!((real - h).abs() < 0.011, "joint {j}: {h} vs {real}");
+        }
+    }
+
+    #[test]
+    fn card_has_every_joint_and_the_constraint_marks() {
+        let card = system_prompt();
+        for name in JOINT_NAMES {
+            assert!(card.contains(&format!("`{name}`")), "{name}");
+        }
+        assert!(card.contains("contact(p, q, d) — **constraint.**"));
+        assert!(card.contains("| 15 | `head` |  | 1.48 |"));
+    }
+}

@@ -1,0 +1,211 @@
+//! `mprog bench solvers`: what steering costs. Each solver at its defaults (the papers'
+//! settings) on one program, next to the unguided sampler it is compared with, as a
+//! markdown table: guide/unguided time ratio (OmniControl reports 3.1×, InterControl 2×),
+//! the inner loop on the fused host FK vs burn's autodiff tape, and latent's seconds per
+//! motion.
+
+use super::score::compile_file;
+use indicatif::{ProgressBar, ProgressStyle};
+use miette::{IntoDiagnostic, Result, WrapErr, miette};
+use mprog::lang::Program;
+use mprog::model::ModelBundle;
+use mprog::model::weights::default_model_dir;
+use mprog::solve::{GuideConfig, LatentConfig, Prior, Progress, SolveRequest, Solver, solve};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Arguments of `mprog bench solvers`.
+#[derive(clap::Args)]
+pub struct SolverBenchArgs {
+    /// The program every solver runs (its prompt and length).
+    #[arg(long, default_value = "programs/hsc1_hand_on_head.mprog")]
+    program: PathBuf,
+    /// Latent iterations actually run at the default chain (DDIM-100); fewer than the
+    /// default 100 measures seconds per iteration and extrapolates the total, saying so.
+    #[arg(long, default_value_t = 100)]
+    latent_iterations: usize,
+    /// Leave out the burn-tape inner loop (`guide` with fused=0), the slowest row.
+    #[arg(long)]
+    skip_tape: bool,
+    /// Seed of every run.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Model bundle (default: the shipped model).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Write the markdown here (atomically) as well as to stdout.
+    #[arg(short, long)]
+    out: Option<PathBuf>,
+}
+
+struct Timed {
+    label: String,
+    seconds: f64,
+    error: f32,
+}
+
+fn timed(
+    bundle: &ModelBundle,
+    program: &Program,
+    prompts: &[String],
+    seed: u64,
+    solver: Solver,
+    label: &str,
+    device: &burn::prelude::Device,
+) -> Result<Timed> {
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{label:>28} {{bar:30}} {{pos}}/{{len}} [{{elapsed}}]"
+        ))
+        .expect("template"),
+    );
+    let req = SolveRequest::new(prompts.to_vec(), program.length(), seed, solver);
+    let error = |j| program.evaluate(j).total;
+    let out = solve(
+        &Prior::from_bundle(bundle),
+        &req,
+        &error,
+        device,
+        |p: Progress| {
+            bar.set_length(p.total as u64);
+            bar.set_position(p.done as u64);
+        },
+    )
+    .into_diagnostic()
+    .wrap_err_with(|| format!("{label} failed"))?;
+    bar.finish_and_clear();
+    eprintln!("{label:>28} {:8.1} s", out.seconds);
+    Ok(Timed {
+        label: label.to_string(),
+        seconds: out.seconds,
+        error: out.error.iter().sum::<f32>() / out.error.len().max(1) as f32,
+    })
+}
+
+/// Runs `mprog bench solvers`.
+pub fn run(args: SolverBenchArgs) -> Result<()> {
+    let device = super::device()?;
+    let program = compile_file(&args.program, &[])?;
+    let prompts: Vec<String> = program
+        .prompts()
+        .into_iter()
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(|| miette!("{}: every person needs a prompt", args.program.display()))?;
+    let dir = args.model.clone().unwrap_or_else(default_model_dir);
+    let bundle = ModelBundle::load(&dir, &device)
+        .into_diagnostic()
+        .wrap_err("cannot load the model")?;
+    let run = |solver: Solver, label: &str| {
+        timed(
+            &bundle, &program, &prompts, args.seed, solver, label, &device,
+        )
+    };
+
+    let guide = GuideConfig::default();
+    let plain_ddpm = run(
+        Solver::Guide(guide.clone()).unguided(),
+        &format!("plain DDPM-{}", guide.steps),
+    )?;
+    let guided = run(Solver::Guide(guide.clone()), "guide (fused inner loop)")?;
+    let tape = if args.skip_tape {
+        None
+    } else {
+        Some(run(
+            Solver::Guide(GuideConfig {
+                fused: false,
+                ..guide.clone()
+            }),
+            "guide (burn autodiff tape)",
+        )?)
+    };
+    let lbfgs_solver = Solver::by_name("lbfgs").expect("known solver");
+    let lbfgs = run(lbfgs_solver, "lbfgs")?;
+
+    let latent = LatentConfig::default();
+    let iterations = args.latent_iterations.clamp(1, latent.iterations);
+    let plain_ddim = run(
+        Solver::Latent(latent.clone()).unguided(),
+        &format!("plain DDIM-{}", latent.ddim_steps),
+    )?;
+    let latent_run = run(
+        Solver::Latent(LatentConfig {
+            iterations,
+            ..latent.clone()
+        }),
+        &format!("latent ({iterations} iterations)"),
+    )?;
+    let fast = LatentConfig {
+        ddim_steps: 10,
+        iterations: 30,
+        lr: 0.02,
+        ..latent.clone()
+    };
+    let latent_fast = run(Solver::Latent(fast.clone()), "latent (10 × 30, lr 0.02)")?;
+
+    let frames = program.length();
+    let mut md = String::new();
+    let _ = writeln!(md, "### Solver cost\n");
+    let _ = writeln!(
+        md,
+        "- program: `{}` ({} frames = {:.1} s, {} person{}), seed {}",
+        args.program.display(),
+        frames,
+        frames as f32 / 20.0,
+        prompts.len(),
+        if prompts.len() == 1 { "" } else { "s" },
+        args.seed
+    );
+    let _ = writeln!(
+        md,
+        "- machine: {}; backend: {}",
+        mprog::backend::machine_description(),
+        mprog::backend::backend_name()
+    );
+    let _ = writeln!(md, "- weights: {}\n", bundle.manifest.weights_id);
+    let _ = writeln!(md, "| run | seconds | × its unguided sampler | error |");
+    let _ = writeln!(md, "| --- | --- | --- | --- |");
+    let row = |md: &mut String, t: &Timed, base: Option<&Timed>| {
+        let ratio = base.map_or("—".to_string(), |b| {
+            format!("{:.2}×", t.seconds / b.seconds)
+        });
+        let _ = writeln!(
+            md,
+            "| {} | {:.1} | {ratio} | {:.4} |",
+            t.label, t.seconds, t.error
+        );
+    };
+    row(&mut md, &plain_ddpm, None);
+    row(&mut md, &guided, Some(&plain_ddpm));
+    if let Some(t) = &tape {
+        row(&mut md, t, Some(&plain_ddpm));
+    }
+    row(&mut md, &lbfgs, Some(&plain_ddpm));
+    row(&mut md, &plain_ddim, None);
+    row(&mut md, &latent_run, Some(&plain_ddim));
+    row(&mut md, &latent_fast, Some(&plain_ddim));
+    let per_iteration = (latent_run.seconds - plain_ddim.seconds).max(0.0) / iterations as f64;
+    let total = plain_ddim.seconds + per_iteration * latent.iterations as f64;
+    let _ = writeln!(
+        md,
+        "\n`latent` at the defaults (DDIM-{}, {} iterations, lr {}): {:.1} s per iteration, \
+         {:.0} s per motion{}.",
+        latent.ddim_steps,
+        latent.iterations,
+        latent.lr,
+        per_iteration,
+        total,
+        if iterations < latent.iterations {
+            format!(" (extrapolated from {iterations} iterations)")
+        } else {
+            " (measured)".to_string()
+        }
+    );
+    print!("{md}");
+    if let Some(path) = &args.out {
+        mprog::fsutil::write_bytes_atomic(path, md.as_bytes())
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
