@@ -79,6 +79,21 @@ fn check_block(page: &Path, b: &CodeBlock) -> Result<(), String> {
                 ))
             }
         }
+        Some("warning") => {
+            let code = b
+                .attrs
+                .get(1)
+                .ok_or(format!("{what}: `mprog,warning` names no code"))?;
+            let d = check_source(&src, &what, &[]);
+            if !d.has_errors() && d.items.iter().any(|i| i.code == code) {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{what}: expected a warning {code} and no errors, got:\n{}",
+                    d.render_plain()
+                ))
+            }
+        }
         Some("repl") => replay(&what, &src),
         Some(other) => Err(format!("{what}: unknown block attribute `{other}`")),
     }

@@ -18,7 +18,7 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 pub struct SolverBenchArgs {
     /// The program every solver runs (its prompt and length).
-    #[arg(long, default_value = "programs/hsc1_hand_on_head.mprog")]
+    #[arg(long, default_value = "programs/fig1_hand_on_head.mprog")]
     program: PathBuf,
     /// Latent iterations actually run at the default chain (DDIM-100); fewer than the
     /// default 100 measures seconds per iteration and extrapolates the total, saying so.

@@ -77,7 +77,7 @@ fn first_sentence(prose: &str) -> String {
 /// The solver runs `scripts/cookbook-renders.sh` makes for every program: (file suffix,
 /// solver, extra `mprog run` arguments).
 pub const COOKBOOK_RENDERS: [(&str, &str, &str); 2] = [
-    ("", "guide", ""),
+    ("", "guide", " --no-baseline"),
     (
         "-latent",
         "latent",
@@ -122,7 +122,7 @@ fn cookbook_page(p: &ProgramFile, book_src: &Path) -> String {
         ));
         if png.with_extension("md").exists() {
             s.push_str(&format!(
-                "Error of each statement, unguided and solved:\n\n{{{{#include ../images/cookbook/{stem}{suffix}.md}}}}\n\n"
+                "Error of each statement:\n\n{{{{#include ../images/cookbook/{stem}{suffix}.md}}}}\n\n"
             ));
         }
     }

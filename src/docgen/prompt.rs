@@ -38,8 +38,8 @@ at end {
         r#"prompt "a person stands and waves with the right hand"
 length 6s
 
-during 50%..end {
-    r_hand.y > head.y + 10 cm
+during 50%..end + 1 {
+    r_hand.y > head.y + 15 cm
 }
 always weight 0.5 { speed(pelvis) < 0.3 }
 "#,
@@ -159,11 +159,21 @@ with one complete program in a ```mprog code block, and nothing the language lac
   keep that start (only `latent` with `relax` may shift the whole motion), so a
   constraint on where the person is at frame 0 cannot be met: write places relative to
   the start (`pelvis@start + [0, 0, 3]`) or make the start part of the region.
+- Only the pelvis's ground position and facing at frame 0 are fixed; the pose (arms,
+  legs, height) at frame 0 is free.
 - Two people: `a` starts at the origin facing +Z, `b` at (0, 0, 2) facing −Z (2 m apart,
-  face to face). Three or more: on a circle around its centre, neighbours 2 m apart, all
-  facing the centre, the first at the origin facing +Z.
+  face to face). P ≥ 3 people stand on a circle with neighbours 2 m apart, all facing
+  its centre (0, 0, r), r = 1 / sin(180°/P) (1.15 m for three): the first at the origin
+  facing +Z, the next ones going round to the first one's right (−X side), so with three
+  people `b` stands front-right of `a` and `c` front-left. Anything closer than 2 m
+  (holding hands, hugging) they walk to.
 - The person is about 1.6 m tall: pelvis ≈ 0.92 m, head joint ≈ 1.48 m when standing
   (table below). Arms are about 0.6 m long (shoulder to wrist), legs about 0.85 m.
+  Across the body: hips ±0.06–0.1 m from the pelvis in x, feet ±0.1–0.25 m (by stance),
+  shoulders ±0.2 m.
+- Speeds: walking ≈ 1.3 m/s (0.07 m per frame), running ≈ 3 m/s (0.15 m per frame); a
+  constraint on a thin region (a hurdle, a line) should be thicker than one frame's
+  travel, or a fast joint can step over it between frames.
 
 ## The language in brief
 
@@ -201,6 +211,14 @@ minimize norm(acc(r_hand))             # any scalar
 - `during a..b` covers frames a ≤ t < b (`during 2s..end` leaves out the last frame;
   `during 2s..end + 1` includes it). Blocks nest and intersect: `at end { weight 2 { … } }`,
   `for f in feet { always { … } }` and `at end weight 2 { … }` are all fine.
+- A statement outside any time block holds on every frame, wherever it sits (inside
+  `for`, `if` or `weight`); `if` may sit inside time blocks and vice versa.
+- `at` takes a list of times; `during` takes one range (write two blocks for two).
+  `end - 2s`, `1.5s`, `-x`, and expressions inside vectors (`[0, 0, d]`) are all fine.
+- `a.pelvis@start` is `(a.pelvis)@start`; `f@start` works on a loop variable.
+- Reserved, not usable as names: `prompt length param def let always at during for in if
+  else weight minimize maximize and or not x y z xz me joints people start mid end true
+  false`.
 - Functions may take people: `def hold(p, q) = dist(p.r_hand, q.l_hand) < 10 cm`;
   `for p in people { … }` loops over every person and `for j in [head, neck]` or
   `for h in hands` over joints.
@@ -246,7 +264,9 @@ const RULES: &str = r#"
 3. Get inequalities the right way round: "the head stays above 1.5 m" is `head.y > 1.5 m`;
    "below the bar" is `head.y < bar`. Read each comparison back as a sentence.
 4. Every constraint must involve the motion (a joint, `massCtr()`, `facing()`, …): a
-   comparison of constants has no effect and is reported.
+   comparison of constants has no effect and is reported. So is a constraint no motion
+   can meet (`mprog::never_met`: a place other than the start at frame 0, a joint 4 m up,
+   20 m travelled in a second).
 5. Keyframes must lie inside the length: with `length 4s`, `at 5s` is an error; prefer
    `start`, `mid`, `end` and percentages.
 6. Give a `length` (at most 9.8 s) and a `prompt` that describes the whole motion; the

@@ -213,6 +213,9 @@ pub struct Statement {
     pub label: String,
     /// Unit of the error (`m`, `m/s`, `rad`, …).
     pub unit: String,
+    /// `minimize`/`maximize`: a value to push, not a constraint to meet.
+    #[serde(default)]
+    pub objective: bool,
 }
 
 /// A whole checked program, ready to evaluate.

@@ -58,7 +58,7 @@ pub use guide::{GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;
 pub use latent::{LatentConfig, Relax};
 pub use lbfgs::LbfgsConfig;
-pub use place::Placement;
+pub use place::{DEFAULT_SPACING, Placement};
 pub use request::{Phase, Prior, Progress, SolveRequest, SolveResult, Solver};
 pub use run::solve;
 

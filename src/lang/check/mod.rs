@@ -17,6 +17,7 @@ mod builder;
 pub mod builtins;
 mod calls;
 mod expr;
+pub mod feasibility;
 mod header;
 mod ops;
 mod stmt;
@@ -273,6 +274,26 @@ pub fn module_to_ir<'a>(
             .help("use fewer nested loops over `joints`, shorter `during` ranges, or a shorter length"),
         );
         return (None, c.diags);
+    }
+    for (i, lowest) in feasibility::never_met(&ir) {
+        let s = &ir.statements[i];
+        c.diags.push(
+            Diagnostic::warning(
+                "mprog::never_met",
+                s.span,
+                format!(
+                    "no motion can meet this constraint: its error is at least {lowest:.3} {}",
+                    s.unit
+                ),
+            )
+            .label("impossible")
+            .help(
+                "heights (`.y`, up) lie between -0.3 and 3 m; each person's pelvis starts at its \
+                 start place (x = z = 0 with one person) and moves at most about 10 m/s. Check \
+                 the axis and the direction of the comparison, and write places relative to the \
+                 start (`pelvis@start + [0, 0, 3]`)",
+            ),
+        );
     }
     let header = c.header.clone();
     (Some(Checked { header, ir, cost }), c.diags)

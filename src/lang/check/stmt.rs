@@ -142,7 +142,7 @@ impl<'a> Checker<'a> {
                 }
                 let k = self.b.konst(&[*sign], value.span);
                 let error = self.b.binary(BinaryOp::Mul, n.node, k, value.span);
-                self.emit(error, n.unit, *span, scx.weight * w, &env, scx);
+                self.emit(error, n.unit, *span, scx.weight * w, true, scx);
             }
             Stmt::Constraint {
                 value,
@@ -153,7 +153,7 @@ impl<'a> Checker<'a> {
                 match self.expr(value, &env, cx) {
                     Val::Formula(f) => {
                         let error = self.formula_error(&f);
-                        self.emit(error, f.unit(), *span, scx.weight * w, &env, scx);
+                        self.emit(error, f.unit(), *span, scx.weight * w, false, scx);
                     }
                     Val::Error => {}
                     other => {
@@ -452,7 +452,7 @@ impl<'a> Checker<'a> {
         unit: Unit,
         span: Span,
         weight: f64,
-        env: &Env<'a>,
+        objective: bool,
         scx: &Scx<'a>,
     ) {
         let cx = &scx.cx;
@@ -472,7 +472,6 @@ impl<'a> Checker<'a> {
                 Some(prev) => self.b.binary(BinaryOp::Mul, prev, m, c.expr.span),
             });
         }
-        let _ = env;
         if !self.b.nodes[error].motion {
             self.error(
                 cx,
@@ -515,6 +514,7 @@ impl<'a> Checker<'a> {
             line,
             label: format!("line {line}: {text}"),
             unit,
+            objective,
         });
     }
 }
