@@ -285,3 +285,25 @@ fn run_solves_the_session_program_with_the_shipped_model() {
     let mut empty = Session::new(None);
     assert!(fails(&mut empty, ":run").contains("length"));
 }
+
+#[test]
+fn view_writes_the_page_with_the_programs_timeline_and_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("walk.html");
+    let mut s = session();
+    say(&mut s, "length 2s");
+    say(&mut s, "distToPlane(r_hand, [0, 0, 2], [0, 0, 1]) < 5 cm");
+    let reply = say(&mut s, &format!(":view {}", page.display()));
+    assert!(reply.contains("wrote"), "{reply}");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(
+        html.contains("\"statement_errors\""),
+        "no timeline in the page"
+    );
+    assert!(html.contains("\"vertical_plane\""), "the wall is not drawn");
+    assert!(
+        html.contains("distToPlane(r_hand"),
+        "the statement's label is on the page"
+    );
+    fails(&mut s, ":view");
+}

@@ -215,10 +215,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         bundle.manifest.weights_id.clone().into(),
     );
     meta.insert("prompts".into(), serde_json::json!(prompts));
-    meta.insert(
-        "statement_errors".into(),
-        statement_errors(&program, people, &device)?,
-    );
+    meta.extend(mprog::view::program::program_meta(&program, people, &device).into_diagnostic()?);
     write_outputs_with(
         &args.out,
         people,
@@ -226,32 +223,4 @@ pub fn run(args: RunArgs) -> Result<()> {
         &format!("{} ({})", program.name(), solver.name()),
         &args.export,
     )
-}
-
-/// `[{label, line, unit, values}]` for the viewer's timeline (`meta.statement_errors`):
-/// one value per frame of the motion, null where the statement does not apply.
-fn statement_errors(
-    program: &Program,
-    people: &[Motion],
-    device: &Device,
-) -> Result<serde_json::Value> {
-    let total = people.iter().map(Motion::len).min().unwrap_or(0);
-    let frames = program
-        .evaluate_frames(sample_tensor(people, device))
-        .into_diagnostic()?;
-    let list: Vec<serde_json::Value> = program
-        .statements()
-        .iter()
-        .zip(frames)
-        .map(|(s, f)| {
-            let mut values: Vec<Option<f32>> = vec![None; total];
-            for ((&t, v), a) in f.frames.iter().zip(&f.errors[0]).zip(&f.applies[0]) {
-                if *a && t < total {
-                    values[t] = Some(*v);
-                }
-            }
-            serde_json::json!({"label": s.label, "line": s.line, "unit": s.unit, "values": values})
-        })
-        .collect();
-    Ok(serde_json::Value::Array(list))
 }

@@ -37,15 +37,7 @@ pub fn compile_file(path: &std::path::Path, set: &[(String, f64)]) -> Result<Pro
 
 /// `[1, people, frames, 22, 3]` tensor of motions cut to a common length.
 pub fn people_tensor(people: &[Motion], device: &Device) -> Tensor<5> {
-    let frames = people.iter().map(Motion::len).min().unwrap_or(0);
-    let data: Vec<f32> = people
-        .iter()
-        .flat_map(|m| Motion::new(m.frames[..frames].to_vec()).to_flat())
-        .collect();
-    Tensor::from_data(
-        TensorData::new(data, [1, people.len(), frames, 22, 3]),
-        device,
-    )
+    mprog::view::program::people_tensor(people, device)
 }
 
 /// Runs `mprog score`.

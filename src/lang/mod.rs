@@ -95,6 +95,17 @@ fn compile_inner(
 }
 
 impl Program {
+    /// Constant geometry the program names (walls, targets, regions), in world
+    /// coordinates, for pictures and the viewer.
+    pub fn overlays(&self) -> &[crate::render::Overlay] {
+        &self.checked.overlays
+    }
+
+    /// Joint-pair contacts the program asks for, with their frames, for the viewer.
+    pub fn contacts(&self) -> &[crate::view::Contact] {
+        &self.checked.contacts
+    }
+
     /// Errors of a batch of motions `[batch, people, frames, 22, 3]` (metres, Y up).
     ///
     /// # Panics

@@ -37,6 +37,8 @@ pub enum Command {
     Score,
     /// `:render out.gif|png`.
     Render(PathBuf),
+    /// `:view out.html`: the 3-D viewer page of the current motion.
+    View(PathBuf),
     /// `:show`: print the session's program.
     Show,
     /// `:clear`: empty the session's program.
@@ -122,6 +124,12 @@ pub const COMMANDS: &[CommandDoc] = &[
         "draw the current motion",
     ),
     doc(
+        "view",
+        &["v"],
+        "OUT.html",
+        "write the 3-D viewer page of the current motion, with the program's geometry and error timeline",
+    ),
+    doc(
         "show",
         &["p"],
         "",
@@ -201,6 +209,7 @@ fn parse_args(cmd: &CommandDoc, args: &str) -> Result<Command, String> {
         "load" => need("a program file").map(|a| Command::Load(unquote(&a).into())),
         "motion" => need("a motion file").map(|a| Command::Motion(unquote(&a).into())),
         "render" => need("an output file").map(|a| Command::Render(unquote(&a).into())),
+        "view" => need("an output .html file").map(|a| Command::View(unquote(&a).into())),
         "eval" => need("an expression or a statement").map(Command::Eval),
         "grad" => need("a statement").map(Command::Grad),
         "gen" => parse_gen(args).map_err(|e| format!("{e}; {}", usage())),

@@ -17,7 +17,7 @@ pub const KEYWORDS: &[&str] = &[
 ];
 
 /// Commands whose argument is a file name.
-pub const FILE_COMMANDS: &[&str] = &["load", "l", "motion", "m", "render", "r"];
+pub const FILE_COMMANDS: &[&str] = &["load", "l", "motion", "m", "render", "r", "view", "v"];
 
 /// What the word before the cursor is.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -96,6 +96,7 @@ impl Session {
             Command::Grad(text) => probe::grad(self, &text),
             Command::Score => probe::score(self),
             Command::Render(path) => self.render(&path),
+            Command::View(path) => self.view(&path),
             Command::Show => Reply::text(self.show()),
             Command::Clear => {
                 self.program.clear();
@@ -325,6 +326,26 @@ impl Session {
                 }
                 reply
             }
+        }
+    }
+
+    fn view(&self, path: &Path) -> Reply {
+        let Some(m) = &self.motion else {
+            return Reply::error(NO_MOTION);
+        };
+        // The program's timeline and geometry when it is complete; the motion alone if not.
+        let meta = match self.program() {
+            Ok(program) => {
+                match crate::view::program::program_meta(&program, &m.people, &self.device) {
+                    Ok(meta) => meta,
+                    Err(e) => return Reply::error(format!("cannot score the motion: {e}")),
+                }
+            }
+            Err(_) => crate::formats::Meta::new(),
+        };
+        match crate::view::write_html(&m.people, &meta, &m.origin, path) {
+            Ok(()) => Reply::text(format!("wrote {}", path.display())),
+            Err(e) => Reply::error(e.to_string()),
         }
     }
 

@@ -31,6 +31,7 @@
 
 pub mod data;
 mod page;
+pub mod program;
 pub mod schema;
 
 #[cfg(test)]

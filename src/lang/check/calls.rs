@@ -37,6 +37,7 @@ impl<'a> Checker<'a> {
             return self.builtin(b, args, span, env, cx);
         }
         if let Some(&f) = self.lib_fns.get(n) {
+            self.note_geometry(n, args, env, cx);
             return self.inline(f, args, span, env, cx, cx.site.or(Some(span)));
         }
         if self.poisoned.contains(n) {

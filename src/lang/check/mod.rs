@@ -18,6 +18,7 @@ pub mod builtins;
 mod calls;
 mod expr;
 pub mod feasibility;
+mod geometry;
 mod header;
 mod ops;
 mod stmt;
@@ -95,6 +96,10 @@ pub struct Checked {
     pub ir: Ir,
     /// Its estimated cost.
     pub cost: CostEstimate,
+    /// Constant geometry it names (walls, targets, regions), for pictures and the viewer.
+    pub overlays: Vec<crate::render::Overlay>,
+    /// Joint-pair contacts it asks for (`contact(a.r_hand, b.r_hand, d)`), with their frames.
+    pub contacts: Vec<crate::view::Contact>,
 }
 
 /// The checker's state while walking one program.
@@ -112,6 +117,10 @@ pub(crate) struct Checker<'a> {
     /// Expressions elaborated so far (see [`MAX_WORK`]).
     pub work: usize,
     pub statements: Vec<crate::lang::ir::Statement>,
+    /// See [`Checked::overlays`].
+    pub overlays: Vec<crate::render::Overlay>,
+    /// Contacts as (end, end, frame domain), resolved into [`Checked::contacts`].
+    pub contacts: Vec<(crate::view::JointOf, crate::view::JointOf, usize)>,
 }
 
 impl<'a> Checker<'a> {
@@ -204,6 +213,8 @@ pub fn module_to_ir<'a>(
         poisoned: Default::default(),
         work: 0,
         statements: Vec::new(),
+        overlays: Vec::new(),
+        contacts: Vec::new(),
     };
     c.load_library(library);
     c.header_items(module, overrides);
@@ -296,7 +307,30 @@ pub fn module_to_ir<'a>(
         );
     }
     let header = c.header.clone();
-    (Some(Checked { header, ir, cost }), c.diags)
+    let overlays = std::mem::take(&mut c.overlays);
+    let contacts = c
+        .contacts
+        .iter()
+        .filter_map(|&(a, b, domain)| {
+            let frames = ir.resolve_domain(domain, ir.length);
+            Some(crate::view::Contact {
+                label: None,
+                a,
+                b,
+                frames: (*frames.iter().min()?, *frames.iter().max()?),
+            })
+        })
+        .collect();
+    (
+        Some(Checked {
+            header,
+            ir,
+            cost,
+            overlays,
+            contacts,
+        }),
+        c.diags,
+    )
 }
 
 impl Checker<'_> {
