@@ -2,9 +2,10 @@
 # Renders every program in programs/ into book/src/images/cookbook/ (a PNG strip and the
 # per-statement error table each) with `guide` at its defaults (without the unguided
 # DDPM-1000 comparison, which would double its time) and with `latent` at a CPU-sized
-# chain (with the unguided DDIM-10 sample next to it) (the runs are listed in src/docgen/book.rs, COOKBOOK_RENDERS), then
-# regenerates the cookbook pages so they include them. Run from the repository root;
-# about one minute per program for guide and 1.5 for latent on a 2-core CPU.
+# chain (with the unguided DDIM-10 sample next to it), then regenerates the cookbook pages
+# so they include them. The runs are listed in src/docgen/book.rs (COOKBOOK_RENDERS).
+# Run from the repository root; about one minute per program for guide and 1.5 for
+# latent on a 2-core CPU (19 programs: about 50 minutes).
 # MPROG=path/to/mprog to use a built binary; ONLY=stem to render one program.
 set -euo pipefail
 mprog=${MPROG:-"cargo run --release --quiet --"}
