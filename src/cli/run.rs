@@ -67,14 +67,9 @@ fn prompts_of(program: &Program, text: &Option<String>) -> Result<Vec<String>> {
         .collect()
 }
 
-/// `[1, people, frames, 22, 3]` of one sample.
-fn sample_tensor(people: &[Motion], device: &Device) -> Tensor<5> {
-    super::score::people_tensor(people, device)
-}
-
 fn per_statement(program: &Program, people: &[Motion], device: &Device) -> Result<Vec<f32>> {
     let e = program
-        .try_evaluate(sample_tensor(people, device))
+        .try_evaluate(mprog::view::program::people_tensor(people, device))
         .into_diagnostic()?;
     e.per_statement
         .into_data()

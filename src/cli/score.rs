@@ -2,10 +2,8 @@
 //! of each statement's error over time.
 
 use super::io::load_people;
-use burn::prelude::*;
 use miette::{IntoDiagnostic, Result, miette};
 use mprog::lang::{FrameErrors, Program};
-use mprog::motion::Motion;
 use mprog::render::{PlotOptions, Series, plot_lines};
 use std::path::PathBuf;
 
@@ -35,11 +33,6 @@ pub fn compile_file(path: &std::path::Path, set: &[(String, f64)]) -> Result<Pro
     })
 }
 
-/// `[1, people, frames, 22, 3]` tensor of motions cut to a common length.
-pub fn people_tensor(people: &[Motion], device: &Device) -> Tensor<5> {
-    mprog::view::program::people_tensor(people, device)
-}
-
 /// Runs `mprog score`.
 pub fn run(args: ScoreArgs) -> Result<()> {
     let program = compile_file(&args.program, &args.set)?;
@@ -54,7 +47,7 @@ pub fn run(args: ScoreArgs) -> Result<()> {
         ));
     }
     let device = super::device()?;
-    let joints = people_tensor(&people, &device);
+    let joints = mprog::view::program::people_tensor(&people, &device);
     let evaluation = program.try_evaluate(joints.clone()).into_diagnostic()?;
     let traces = program.evaluate_frames(joints).into_diagnostic()?;
     let per = evaluation
