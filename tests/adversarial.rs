@@ -1183,7 +1183,9 @@ fn cli_convert_with_one_bad_output_writes_none() {
 }
 
 #[test]
-fn cli_convert_two_people_to_bvh_writes_none() {
+fn cli_convert_two_degenerate_people_to_bvh_writes_none() {
+    // Two people (one BVH each), every joint at one point: no facing direction, so BVH
+    // export refuses, and the JSON asked for first must not be left behind either.
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
         dir.path().join("two.npy"),
@@ -1191,7 +1193,7 @@ fn cli_convert_two_people_to_bvh_writes_none() {
     )
     .unwrap();
     let out = mprog(dir.path(), &["convert", "two.npy", "-o", "a.json", "b.bvh"]);
-    assert_cli_error(&out, &["b.bvh", "2 people"]);
+    assert_cli_error(&out, &["b_p1.bvh", "facing", "nothing was written"]);
     assert_no_outputs(dir.path(), &["two.npy"]);
 }
 

@@ -148,3 +148,33 @@ fn view_writes_one_self_contained_page() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("writes an HTML page"));
 }
+
+#[test]
+fn two_people_to_bvh_write_one_file_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, joints) = golden();
+    let people = [
+        Person {
+            name: "a".into(),
+            motion: joints.clone(),
+        },
+        Person {
+            name: "b".into(),
+            motion: joints,
+        },
+    ];
+    write_json(&dir.path().join("two.json"), &people, &Meta::new()).unwrap();
+    let stderr = ok(&mprog(
+        &["convert", "two.json", "-o", "pair.bvh"],
+        dir.path(),
+    ));
+    for name in ["pair_p1.bvh", "pair_p2.bvh"] {
+        assert!(stderr.contains(name), "{stderr}");
+        let bvh = std::fs::read_to_string(dir.path().join(name)).unwrap();
+        assert!(
+            bvh.starts_with("HIERARCHY") || bvh.contains("HIERARCHY"),
+            "{name}"
+        );
+    }
+    assert!(!dir.path().join("pair.bvh").exists());
+}

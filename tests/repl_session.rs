@@ -307,3 +307,41 @@ fn view_writes_the_page_with_the_programs_timeline_and_geometry() {
     );
     fails(&mut s, ":view");
 }
+
+#[test]
+fn save_writes_the_program_and_the_motion_with_its_scores() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = session();
+    say(&mut s, "length 2s");
+    say(&mut s, "head.y > 1.5 m");
+    let prog = dir.path().join("typed.mprog");
+    say(&mut s, &format!(":save {}", prog.display()));
+    let text = std::fs::read_to_string(&prog).unwrap();
+    assert_eq!(text, "length 2s\nhead.y > 1.5 m\n");
+    // The saved program checks as a file, exactly as typed.
+    compile(&text, "typed.mprog", &[]).unwrap();
+
+    let json = dir.path().join("walk.json");
+    say(&mut s, &format!(":w {}", json.display()));
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(doc["people"][0]["frames"].as_array().unwrap().len(), F);
+    assert_eq!(doc["meta"]["origin"], "walk");
+    assert!(
+        doc["meta"]["statement_errors"].is_array(),
+        "{}",
+        doc["meta"]
+    );
+    let npy = dir.path().join("walk.npy");
+    say(&mut s, &format!(":save {}", npy.display()));
+    assert!(dir.path().join("walk.meta.json").exists());
+
+    assert!(
+        fails(
+            &mut s,
+            &format!(":save {}", dir.path().join("x.gif").display())
+        )
+        .contains(":render")
+    );
+    assert!(fails(&mut Session::new(None), ":save p.mprog").contains("empty"));
+}

@@ -114,9 +114,10 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
         Some(run(
             Solver::Guide(GuideConfig {
                 fused: false,
+                keep_skeleton: false,
                 ..guide.clone()
             }),
-            "guide (burn autodiff tape)",
+            "guide (burn autodiff tape, skeleton=0)",
         )?)
     };
     let lbfgs_solver = Solver::by_name("lbfgs").expect("known solver");

@@ -62,7 +62,7 @@ pub fn run(args: &CheckArgs) -> miette::Result<bool> {
                 let text = if args.plain {
                     diags.render_plain()
                 } else {
-                    diags.render_fancy()
+                    diags.render_for(std::io::IsTerminal::is_terminal(&std::io::stdout()))
                 };
                 print!("{text}");
                 let warnings = diags.warnings().count();

@@ -64,7 +64,7 @@ pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
 /// Runs `mprog gen`.
 pub fn run(args: GenArgs) -> Result<()> {
     let started = Instant::now();
-    check_outputs(&args.out, 1)?;
+    check_outputs(&args.out)?;
     args.export.check_against(&args.out)?;
     let device = super::device()?;
     let dir = args.model.clone().unwrap_or_else(default_model_dir);

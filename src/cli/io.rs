@@ -51,7 +51,8 @@ pub fn write_outputs_with(
     export: &ExportArgs,
 ) -> Result<()> {
     export.check_against(outputs)?;
-    check_outputs(outputs, people.len())?;
+    check_outputs(outputs)?;
+    let mut bvh_files = bvh_texts(outputs, people, export)?;
     for out in outputs {
         let ext = out
             .extension()
@@ -78,7 +79,16 @@ pub fn write_outputs_with(
                 eprintln!("wrote {} (+ {})", out.display(), path.display());
                 continue;
             }
-            "json" | "bvh" => {
+            "bvh" => {
+                for (path, text) in bvh_files.remove(0) {
+                    mprog::fsutil::write_bytes_atomic(&path, text.as_bytes())
+                        .into_diagnostic()
+                        .wrap_err_with(|| format!("writing {}", path.display()))?;
+                    eprintln!("wrote {}", path.display());
+                }
+                continue;
+            }
+            "json" => {
                 write_motion_with(out, people, meta, &export.bvh_options()).into_diagnostic()?
             }
             _ => {
@@ -100,20 +110,64 @@ fn extension(path: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// Whether every output can hold `people` motions, judged by its extension.
-pub fn check_outputs(outputs: &[PathBuf], people: usize) -> Result<()> {
-    outputs.iter().try_for_each(|out| check_output(out, people))
+/// Whether every output is of a kind mprog writes, judged by its extension (before any
+/// work is done, so a typo does not cost a generation).
+pub fn check_outputs(outputs: &[PathBuf]) -> Result<()> {
+    outputs.iter().try_for_each(|out| check_output(out))
 }
 
-fn check_output(out: &Path, people: usize) -> Result<()> {
+/// The text of every BVH file the outputs ask for, in output order (one list per `.bvh`
+/// output: one file per person). Made before anything is written, because BVH export can
+/// refuse a motion (a pose with no facing direction) and no output should then exist.
+fn bvh_texts(
+    outputs: &[PathBuf],
+    people: &[Motion],
+    export: &ExportArgs,
+) -> Result<Vec<Vec<(PathBuf, String)>>> {
+    let opts = export.bvh_options();
+    let mut all = Vec::new();
+    for out in outputs.iter().filter(|o| extension(o) == "bvh") {
+        let mut files = Vec::new();
+        for (i, person) in people.iter().enumerate() {
+            if person
+                .frames
+                .iter()
+                .any(|p| !p.iter().all(|v| v.is_finite()))
+            {
+                return Err(miette!(
+                    "cannot write {}: person {} has non-finite joint positions; nothing was written",
+                    out.display(),
+                    i + 1
+                ));
+            }
+            let path = if people.len() == 1 {
+                out.clone()
+            } else {
+                per_person(out, i)
+            };
+            let text = mprog::formats::bvh_export::bvh_string(person, &opts).map_err(|e| {
+                miette!(
+                    "{}: cannot export this motion as BVH: {e}; nothing was written",
+                    path.display()
+                )
+            })?;
+            files.push((path, text));
+        }
+        all.push(files);
+    }
+    Ok(all)
+}
+
+/// `out.bvh` → `out_p{i+1}.bvh`: person `i`'s file when a motion has several people.
+pub fn per_person(out: &Path, i: usize) -> PathBuf {
+    let stem = out.file_stem().unwrap_or_default().to_string_lossy();
+    let ext = out.extension().unwrap_or_default().to_string_lossy();
+    out.with_file_name(format!("{stem}_p{}.{ext}", i + 1))
+}
+
+fn check_output(out: &Path) -> Result<()> {
     match extension(out).as_str() {
-        "gif" | "png" | "npy" | "json" | "html" | "htm" => Ok(()),
-        "bvh" if people == 1 => Ok(()),
-        "bvh" => Err(miette!(
-            help = "write one .bvh per person, or use .json / .npy",
-            "cannot write {}: a BVH file holds one skeleton but there are {people} people",
-            out.display()
-        )),
+        "gif" | "png" | "npy" | "json" | "html" | "htm" | "bvh" => Ok(()),
         _ => Err(miette!(
             help = "use .bvh, .npy, .json, .gif, .png or .html",
             "cannot write {}: unknown extension",

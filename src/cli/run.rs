@@ -42,7 +42,7 @@ pub struct RunArgs {
     /// Model bundle folder (default: models/default).
     #[arg(long)]
     model: Option<PathBuf>,
-    /// Outputs by extension: .bvh (one person) .npy .json .gif .png.
+    /// Outputs by extension: .bvh (several people: one file each, `out_p1.bvh`, …), .npy, .json, .gif, .png, .html.
     #[arg(short, long, num_args = 1.., required = true)]
     out: Vec<PathBuf>,
     #[command(flatten)]
@@ -132,7 +132,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let program = compile_file(&args.program, &args.set)?;
     let solver = solver_with_knobs(&args.solver, &args.knobs)?;
     let prompts = prompts_of(&program, &args.text)?;
-    check_outputs(&args.out, prompts.len())?;
+    check_outputs(&args.out)?;
     args.export.check_against(&args.out)?;
     let device = super::device()?;
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
@@ -167,6 +167,12 @@ pub fn run(args: RunArgs) -> Result<()> {
             s.line, s.unit, guided[i]
         );
     }
+    let total: f32 = guided.iter().sum();
+    let base_total = baseline.as_ref().map_or("—".into(), |(b, _)| {
+        format!("{:.4}", b.iter().sum::<f32>())
+    });
+    println!("| | **total** | | {base_total} | {total:.4} |");
+    // After the table, so a terminal does not interleave them with its rows.
     if let Some((base, _)) = &baseline {
         for (s, b) in program.statements().iter().zip(base) {
             if *b <= 0.0 && ["<", ">", "<=", ">="].iter().any(|op| s.label.contains(op)) {
@@ -177,11 +183,6 @@ pub fn run(args: RunArgs) -> Result<()> {
             }
         }
     }
-    let total: f32 = guided.iter().sum();
-    let base_total = baseline.as_ref().map_or("—".into(), |(b, _)| {
-        format!("{:.4}", b.iter().sum::<f32>())
-    });
-    println!("| | **total** | | {base_total} | {total:.4} |");
     match &baseline {
         Some((_, s)) => eprintln!(
             "{}: {:.1} s (unguided: {s:.1} s)",

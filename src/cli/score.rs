@@ -28,7 +28,10 @@ pub fn compile_file(path: &std::path::Path, set: &[(String, f64)]) -> Result<Pro
         .map_err(|e| miette!("cannot read {}: {e}", path.display()))?;
     let name = path.display().to_string();
     mprog::lang::compile(&source, &name, set).map_err(|diags| {
-        eprint!("{}", diags.render_fancy());
+        eprint!(
+            "{}",
+            diags.render_for(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        );
         miette!("{name} has errors")
     })
 }

@@ -207,6 +207,20 @@ impl Diagnostics {
     pub fn render_fancy(&self) -> String {
         self.render(GraphicalTheme::unicode())
     }
+
+    /// The fancy layout without colour codes (for pipes and files).
+    pub fn render_uncoloured(&self) -> String {
+        self.render(GraphicalTheme::unicode_nocolor())
+    }
+
+    /// Fancy with colour for a terminal (unless `NO_COLOR` is set), uncoloured otherwise.
+    pub fn render_for(&self, to_terminal: bool) -> String {
+        if to_terminal && std::env::var_os("NO_COLOR").is_none() {
+            self.render_fancy()
+        } else {
+            self.render_uncoloured()
+        }
+    }
 }
 
 impl fmt::Display for Diagnostics {

@@ -62,7 +62,7 @@ fn axis_name(v: Vec3) -> &'static str {
 pub(crate) fn top_caption(scene: &Scene, view: &View) -> String {
     let (right, up) = (axis_name(view.basis.right), axis_name(view.basis.up));
     format!(
-        "top view (right {right}, up {up}, grid {} m)",
+        "top view, looking down (to the right: {right}, upwards: {up}; grid {} m); dark limbs: right side, light: left",
         scene.grid_step()
     )
 }

@@ -39,6 +39,8 @@ pub enum Command {
     Render(PathBuf),
     /// `:view out.html`: the 3-D viewer page of the current motion.
     View(PathBuf),
+    /// `:save FILE`: the program (`.mprog`) or the current motion (`.bvh`, `.npy`, `.json`).
+    Save(PathBuf),
     /// `:show`: print the session's program.
     Show,
     /// `:clear`: empty the session's program.
@@ -130,6 +132,12 @@ pub const COMMANDS: &[CommandDoc] = &[
         "write the 3-D viewer page of the current motion, with the program's geometry and error timeline",
     ),
     doc(
+        "save",
+        &["w"],
+        "FILE.mprog | OUT.bvh | OUT.npy | OUT.json",
+        "write the session's program, or the current motion (with the program, scores and geometry in its meta)",
+    ),
+    doc(
         "show",
         &["p"],
         "",
@@ -210,6 +218,7 @@ fn parse_args(cmd: &CommandDoc, args: &str) -> Result<Command, String> {
         "motion" => need("a motion file").map(|a| Command::Motion(unquote(&a).into())),
         "render" => need("an output file").map(|a| Command::Render(unquote(&a).into())),
         "view" => need("an output .html file").map(|a| Command::View(unquote(&a).into())),
+        "save" => need("a file").map(|a| Command::Save(unquote(&a).into())),
         "eval" => need("an expression or a statement").map(Command::Eval),
         "grad" => need("a statement").map(Command::Grad),
         "gen" => parse_gen(args).map_err(|e| format!("{e}; {}", usage())),

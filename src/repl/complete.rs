@@ -104,7 +104,7 @@ mod tests {
     fn commands_complete_at_line_start() {
         assert_eq!(word_at(":lo", 3), (0, Context::Command));
         assert_eq!(command_candidates(":lo"), vec![":load"]);
-        assert_eq!(command_candidates(":s"), vec![":score", ":show"]);
+        assert_eq!(command_candidates(":s"), vec![":save", ":score", ":show"]);
     }
 
     #[test]

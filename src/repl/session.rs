@@ -97,6 +97,7 @@ impl Session {
             Command::Score => probe::score(self),
             Command::Render(path) => self.render(&path),
             Command::View(path) => self.view(&path),
+            Command::Save(path) => self.save(&path),
             Command::Show => Reply::text(self.show()),
             Command::Clear => {
                 self.program.clear();
@@ -329,19 +330,69 @@ impl Session {
         }
     }
 
+    /// The program's timeline and geometry for the current motion when the program is
+    /// complete; nothing if not.
+    fn motion_meta(&self, m: &CurrentMotion) -> Result<crate::formats::Meta, String> {
+        match self.program() {
+            Ok(program) => crate::view::program::program_meta(&program, &m.people, &self.device)
+                .map_err(|e| format!("cannot score the motion: {e}")),
+            Err(_) => Ok(crate::formats::Meta::new()),
+        }
+    }
+
+    fn save(&self, path: &Path) -> Reply {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        if ext == "mprog" {
+            if self.program.trim().is_empty() {
+                return Reply::error("the program is empty: nothing to save");
+            }
+            let mut text = self.program.clone();
+            if !text.ends_with('\n') {
+                text.push('\n');
+            }
+            return match crate::fsutil::write_bytes_atomic(path, text.as_bytes()) {
+                Ok(()) => Reply::text(format!("wrote {}", path.display())),
+                Err(e) => Reply::error(format!("cannot write {}: {e}", path.display())),
+            };
+        }
+        if !matches!(ext.as_str(), "bvh" | "npy" | "json") {
+            return Reply::error(format!(
+                "cannot save {}: use .mprog (the program), or .bvh, .npy or .json (the motion); `:render` writes pictures and `:view` pages",
+                path.display()
+            ));
+        }
+        let Some(m) = &self.motion else {
+            return Reply::error(NO_MOTION);
+        };
+        let mut meta = match self.motion_meta(m) {
+            Ok(meta) => meta,
+            Err(e) => return Reply::error(e),
+        };
+        meta.insert("origin".into(), m.origin.clone().into());
+        let bvh = crate::formats::bvh_export::BvhExportOptions::default();
+        if let Err(e) = crate::formats::write_motion_with(path, &m.people, &meta, &bvh) {
+            return Reply::error(e.to_string());
+        }
+        if ext == "npy" {
+            // As `mprog run` does: the meta goes in a sidecar next to the array.
+            meta.insert("fps".into(), FPS.into());
+            if let Err(e) = crate::formats::write_sidecar_meta(path, &meta) {
+                return Reply::error(e.to_string());
+            }
+        }
+        Reply::text(format!("wrote {}", path.display()))
+    }
+
     fn view(&self, path: &Path) -> Reply {
         let Some(m) = &self.motion else {
             return Reply::error(NO_MOTION);
         };
-        // The program's timeline and geometry when it is complete; the motion alone if not.
-        let meta = match self.program() {
-            Ok(program) => {
-                match crate::view::program::program_meta(&program, &m.people, &self.device) {
-                    Ok(meta) => meta,
-                    Err(e) => return Reply::error(format!("cannot score the motion: {e}")),
-                }
-            }
-            Err(_) => crate::formats::Meta::new(),
+        let meta = match self.motion_meta(m) {
+            Ok(meta) => meta,
+            Err(e) => return Reply::error(e),
         };
         match crate::view::write_html(&m.people, &meta, &m.origin, path) {
             Ok(()) => Reply::text(format!("wrote {}", path.display())),
@@ -353,12 +404,9 @@ impl Session {
         let Some(m) = &self.motion else {
             return Reply::error(NO_MOTION);
         };
-        let title = self
-            .program()
-            .ok()
-            .and_then(|p| p.prompt().map(str::to_string))
-            .unwrap_or_else(|| m.origin.clone());
-        match render_to_path(&m.people, &RenderOptions::titled(title), path) {
+        // Titled with where the motion came from: after `:gen` the program's prompt is not
+        // what was generated.
+        match render_to_path(&m.people, &RenderOptions::titled(&m.origin), path) {
             Ok(()) => Reply::text(format!("wrote {}", path.display())),
             Err(e) => Reply::error(format!("cannot render {}: {e}", path.display())),
         }

@@ -9,6 +9,21 @@
 //!                  μ ← μ − τ·Σ̂·g
 //! x_{t−1} ← μ + σ_t·ε   (no noise at the last step)
 //! ```
+//! In the last T_s steps the inner loop works on the skeleton (mprog's addition, on by
+//! default: [`GuideConfig::keep_skeleton`]): it minimises `E(P(μ))` and writes `P(μ)` back,
+//! where `P` restores the bone lengths and keeps planted feet on the floor
+//! ([`super::bones`]). Without it the 500 late iterations meet a constraint by moving one
+//! joint away from its bones (a head pulled into the chest), which nothing repairs later.
+//!
+//! In the same last T_s steps each iteration steps along the gradient smoothed over time
+//! (mprog's addition, [`GuideConfig::smooth_frames`]): a Gaussian over frames, a
+//! Sobolev-style preconditioner. It is still a descent direction and the Polyak step still
+//! removes the same fraction of the linearised error, but a keyframe moves its neighbours
+//! too, so "head below 0.5 m at frame 60" becomes a dip over about a second instead of a
+//! one-frame spike. Earlier steps keep OmniControl's raw gradient: there the denoiser
+//! answers every edit, and smoothed edits of every frame's pose led it elsewhere (a walk
+//! between two close walls stopped walking).
+//!
 //! The denoiser is not in the inner loop: only FK, the error and its gradient are, through
 //! the fused host path ([`super::host`]) by default.
 //!
@@ -99,6 +114,13 @@ pub struct GuideConfig {
     /// Evaluate the inner loop through the fused host FK (fast); `false` runs it through the
     /// burn graph (the reference, for tests and checks).
     pub fused: bool,
+    /// In the last `late_steps` steps, optimise through the skeleton projection and write
+    /// it back ([`super::bones`]): bone lengths kept, planted feet kept on the floor. Needs
+    /// the fused path.
+    pub keep_skeleton: bool,
+    /// σ in frames of the Gaussian the gradient is smoothed with over time before each
+    /// step of the last `late_steps` steps (0: OmniControl's raw gradient).
+    pub smooth_frames: f32,
 }
 
 impl Default for GuideConfig {
@@ -114,6 +136,8 @@ impl Default for GuideConfig {
             step_rule: StepRule::Polyak,
             freeze_first_frame: true,
             fused: true,
+            keep_skeleton: true,
+            smooth_frames: 4.0,
         }
     }
 }
@@ -131,6 +155,16 @@ impl GuideConfig {
                 "guide: τ and the variance bound must be finite and ≥ 0".into(),
             ));
         }
+        if !(self.smooth_frames.is_finite() && (0.0..=100.0).contains(&self.smooth_frames)) {
+            return Err(SolveError::Invalid(
+                "guide: smooth_frames (σ of the gradient's smoothing over time) must be between 0 and 100 frames".into(),
+            ));
+        }
+        if self.keep_skeleton && !self.fused {
+            return Err(SolveError::Invalid(
+                "guide: keeping the skeleton needs the fused inner loop (set fused or turn keep_skeleton off)".into(),
+            ));
+        }
         Ok(())
     }
 
@@ -140,6 +174,16 @@ impl GuideConfig {
             self.k_late
         } else {
             self.k_early
+        }
+    }
+
+    /// σ (frames) of the gradient's smoothing at step `i` (0 = the last): `smooth_frames`
+    /// in the last `late_steps` steps, 0 before.
+    pub fn smoothing_at(&self, i: usize) -> f32 {
+        if i < self.late_steps {
+            self.smooth_frames
+        } else {
+            0.0
         }
     }
 
@@ -184,9 +228,11 @@ pub(crate) fn run(
         if k > 0 {
             let mut full = host(mu);
             let values = if cfg.fused {
-                guide_fused(ctx, cfg, &mut objective, &mut full, k, step, &at)?
+                let skeleton = cfg.keep_skeleton && i < cfg.late_steps;
+                let inner = Inner { k, step, skeleton };
+                guide_fused(ctx, cfg, &mut objective, &mut full, inner, i, &at)?
             } else {
-                guide_graph(ctx, cfg, &mut full, k, step, &at)?
+                guide_graph(ctx, cfg, &mut full, k, step, i, &at)?
             };
             mu = Tensor::from_data(TensorData::new(full, dims), &ctx.device);
             last = Some(mean(&values));
@@ -211,6 +257,15 @@ pub(crate) fn run(
     })
 }
 
+/// One denoising step's inner loop: K iterations of this step size, through the skeleton
+/// projection or not.
+#[derive(Clone, Copy)]
+struct Inner {
+    k: usize,
+    step: f32,
+    skeleton: bool,
+}
+
 /// K steps on the head columns of `full` through the fused host path; returns the error
 /// of the last evaluation.
 fn guide_fused(
@@ -218,24 +273,35 @@ fn guide_fused(
     cfg: &GuideConfig,
     objective: &mut HostObjective,
     full: &mut [f32],
-    k: usize,
-    step: f32,
+    Inner { k, step, skeleton }: Inner,
+    i: usize,
     at: &dyn Fn(usize) -> String,
 ) -> Result<Vec<f32>, SolveError> {
+    let sigma = cfg.smoothing_at(i);
     let mut head = extract_head(full, FEATURE_DIM);
     let mut grad = vec![0.0; head.len()];
     let mut values = Vec::new();
+    if skeleton {
+        objective.project_skeleton(&head);
+    }
     for it in 0..k {
         values = objective.eval(&head, &mut grad)?;
         ensure_finite(&values, "guide", "error", || at(it))?;
         ensure_finite(&grad, "guide", "gradient", || at(it))?;
+        let mut dir = smooth_over_frames(&grad, ctx.frames, HEAD, sigma);
         if cfg.freeze_first_frame {
             for m in 0..ctx.motions() {
                 let f0 = m * ctx.frames * HEAD;
                 grad[f0..f0 + HEAD].fill(0.0);
+                dir[f0..f0 + HEAD].fill(0.0);
             }
         }
-        apply_step(cfg, &mut head, &grad, &values, step);
+        apply_step(cfg, &mut head, &grad, &dir, &values, step);
+    }
+    if skeleton {
+        // The error was of P(head): make that what the chain carries on with.
+        objective.apply_projection(&mut head);
+        objective.stop_projecting();
     }
     insert_head(full, FEATURE_DIM, &head);
     Ok(values)
@@ -248,8 +314,10 @@ fn guide_graph(
     full: &mut [f32],
     k: usize,
     step: f32,
+    i: usize,
     at: &dyn Fn(usize) -> String,
 ) -> Result<Vec<f32>, SolveError> {
+    let sigma = cfg.smoothing_at(i);
     let ad = ctx.device.clone().autodiff();
     let dims = ctx.dims();
     let mut values = Vec::new();
@@ -270,40 +338,88 @@ fn guide_graph(
         }
         .unwrap_or_else(|| vec![0.0; full.len()]);
         ensure_finite(&g, "guide", "gradient", || at(it))?;
+        let mut dir = smooth_over_frames(&g, ctx.frames, FEATURE_DIM, sigma);
         if cfg.freeze_first_frame {
             for m in 0..ctx.motions() {
                 let f0 = m * ctx.frames * FEATURE_DIM;
                 g[f0..f0 + FEATURE_DIM].fill(0.0);
+                dir[f0..f0 + FEATURE_DIM].fill(0.0);
             }
         }
-        apply_step(cfg, full, &g, &values, step);
+        apply_step(cfg, full, &g, &dir, &values, step);
     }
     Ok(values)
 }
 
-/// `x ← x − s·g` with `s` from the step rule; `x` and `g` hold the samples one after the
-/// other (equal blocks), `values` their errors.
-fn apply_step(cfg: &GuideConfig, x: &mut [f32], g: &[f32], values: &[f32], step: f32) {
+/// `x ← x − s·d` along direction `d` (the gradient `g`, smoothed or not) with `s` from the
+/// step rule; `x`, `g` and `d` hold the samples one after the other (equal blocks),
+/// `values` their errors. The linearised error drops by `s·⟨g, d⟩`.
+fn apply_step(cfg: &GuideConfig, x: &mut [f32], g: &[f32], d: &[f32], values: &[f32], step: f32) {
     match cfg.step_rule {
         StepRule::Gradient => {
-            for (x, g) in x.iter_mut().zip(g) {
-                *x -= step * g;
+            for (x, d) in x.iter_mut().zip(d) {
+                *x -= step * d;
             }
         }
         StepRule::Polyak => {
             let per = x.len() / values.len();
             let fraction = step.min(1.0) as f64;
-            for ((xb, gb), &e) in x.chunks_exact_mut(per).zip(g.chunks_exact(per)).zip(values) {
-                let norm2: f64 = gb.iter().map(|v| (*v as f64) * (*v as f64)).sum();
-                if norm2 <= 1e-20 || e <= 0.0 {
+            let blocks = x
+                .chunks_exact_mut(per)
+                .zip(g.chunks_exact(per))
+                .zip(d.chunks_exact(per));
+            for (((xb, gb), db), &e) in blocks.zip(values) {
+                let slope: f64 = gb
+                    .iter()
+                    .zip(db)
+                    .map(|(g, d)| (*g as f64) * (*d as f64))
+                    .sum();
+                if slope <= 1e-20 || e <= 0.0 {
                     continue;
                 }
-                let g_max = gb.iter().fold(0.0f32, |m, v| m.max(v.abs()));
-                let s = ((fraction * e as f64 / norm2) as f32).min(MAX_POLYAK_DELTA / g_max);
-                for (x, g) in xb.iter_mut().zip(gb) {
-                    *x -= s * g;
+                let d_max = db.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+                let s = ((fraction * e as f64 / slope) as f32).min(MAX_POLYAK_DELTA / d_max);
+                for (x, d) in xb.iter_mut().zip(db) {
+                    *x -= s * d;
                 }
             }
         }
     }
+}
+
+/// Feature columns left unsmoothed: root yaw velocity, root XZ velocity, root height. The
+/// root's path integrates the first three, so a smoothed gradient there turns the whole
+/// walk (a dense "stay between two walls" stopped walking and turned on the spot).
+pub const UNSMOOTHED_COLUMNS: usize = 4;
+
+/// Each column of `[M, N, width]` rows from [`UNSMOOTHED_COLUMNS`] on, convolved over its
+/// N frames with a Gaussian of σ `sigma` frames (zero outside the motion, so the operator
+/// is symmetric and positive semi-definite and the result stays a descent direction); the
+/// root columns and everything with `sigma` 0 are returned unchanged.
+pub fn smooth_over_frames(v: &[f32], frames: usize, width: usize, sigma: f32) -> Vec<f32> {
+    if sigma <= 0.0 || frames < 2 {
+        return v.to_vec();
+    }
+    let radius = ((3.0 * sigma).ceil() as usize).min(frames - 1);
+    let kernel: Vec<f32> = (0..=radius)
+        .map(|k| (-0.5 * (k as f32 / sigma).powi(2)).exp())
+        .collect();
+    let mut out = vec![0.0; v.len()];
+    for (src, dst) in v
+        .chunks_exact(frames * width)
+        .zip(out.chunks_exact_mut(frames * width))
+    {
+        for t in 0..frames {
+            let row = &mut dst[t * width..(t + 1) * width];
+            let lo = t.saturating_sub(radius);
+            let hi = (t + radius).min(frames - 1);
+            for u in lo..=hi {
+                let w = kernel[t.abs_diff(u)];
+                for (o, x) in row.iter_mut().zip(&src[u * width..(u + 1) * width]) {
+                    *o += w * x;
+                }
+            }
+        }
+    }
+    out
 }

@@ -15,6 +15,7 @@
 //! The backward runs these in reverse (reverse cumulative sums for the two prefix sums).
 //! Tests check forward and gradient against the burn graph ([`super::Decoder`]).
 
+use super::bones::SkeletonProjection;
 use super::decode::Decoder;
 use super::place::Placement;
 use super::{MotionError, SolveError};
@@ -142,8 +143,11 @@ pub struct HostObjective<'a> {
     std: Vec<f32>,
     placements: Vec<Placement>,
     fk: HostFk,
+    /// De-normalised heads of the last evaluation (after the projection, if any).
     head: Vec<f32>,
     joints: Vec<f32>,
+    /// Skeleton projection applied before the FK ([`Self::project_skeleton`]).
+    projection: Option<SkeletonProjection>,
 }
 
 impl<'a> HostObjective<'a> {
@@ -167,18 +171,63 @@ impl<'a> HostObjective<'a> {
             fk: HostFk::default(),
             head: Vec::new(),
             joints: Vec::new(),
+            projection: None,
         }
+    }
+
+    /// From now on evaluate the error of `P(head)`, the skeleton projection set up on these
+    /// normalised heads (see [`super::bones`]); returns how many frames have a planted foot.
+    pub fn project_skeleton(&mut self, head: &[f32]) -> usize {
+        let map = SkeletonProjection::new(&self.denormalize(head));
+        let anchored = map.anchored();
+        self.projection = Some(map);
+        anchored
+    }
+
+    /// Evaluate the error of the heads as they are again.
+    pub fn stop_projecting(&mut self) {
+        self.projection = None;
+    }
+
+    /// Replaces normalised heads by their projection (no-op when not projecting).
+    pub fn apply_projection(&mut self, head: &mut [f32]) {
+        if self.projection.is_none() {
+            return;
+        }
+        let input = self.denormalize(head);
+        let mut out = vec![0.0; input.len()];
+        if let Some(p) = &mut self.projection {
+            p.forward(&input, &mut out);
+        }
+        for (row, o) in head.chunks_exact_mut(HEAD).zip(out.chunks_exact(HEAD)) {
+            for (((x, o), s), m) in row.iter_mut().zip(o).zip(&self.std).zip(&self.mean) {
+                *x = (o - m) / s;
+            }
+        }
+    }
+
+    fn denormalize(&self, head: &[f32]) -> Vec<f32> {
+        head.chunks_exact(HEAD)
+            .flat_map(|row| {
+                row.iter()
+                    .zip(&self.std)
+                    .zip(&self.mean)
+                    .map(|((x, s), m)| x * s + m)
+            })
+            .collect()
     }
 
     /// World joints `[B, P, N, 22, 3]` (flat) of normalised heads.
     pub fn world_joints(&mut self, head: &[f32]) -> &[f32] {
-        self.head.clear();
-        self.head.extend(head.chunks_exact(HEAD).flat_map(|row| {
-            row.iter()
-                .zip(&self.std)
-                .zip(&self.mean)
-                .map(|((x, s), m)| x * s + m)
-        }));
+        let plain = self.denormalize(head);
+        self.head = match &mut self.projection {
+            Some(p) => {
+                let mut out = vec![0.0; plain.len()];
+                p.forward(&plain, &mut out);
+                out
+            }
+            None => plain,
+        };
         self.joints.resize(head.len() / HEAD * J3, 0.0);
         self.fk.forward(&self.head, self.frames, &mut self.joints);
         let per = self.frames * NUM_JOINTS;
@@ -238,6 +287,10 @@ impl<'a> HostObjective<'a> {
             }
         }
         self.fk.backward(&self.head, &g, grad);
+        if let Some(p) = &self.projection {
+            let g_projected = grad.to_vec();
+            p.backward(&g_projected, grad);
+        }
         for row in grad.chunks_exact_mut(HEAD) {
             for (v, s) in row.iter_mut().zip(&self.std) {
                 *v *= s;

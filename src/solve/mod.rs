@@ -40,6 +40,7 @@
 //! ```
 
 pub mod adam;
+pub mod bones;
 mod decode;
 pub mod guide;
 pub mod host;

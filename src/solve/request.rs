@@ -83,7 +83,15 @@ impl Solver {
     pub fn knob_names(&self) -> &'static [&'static str] {
         match self {
             Solver::Plain(_) => &["steps"],
-            Solver::Guide(_) => &["steps", "k_early", "k_late", "late_steps", "tau"],
+            Solver::Guide(_) => &[
+                "steps",
+                "k_early",
+                "k_late",
+                "late_steps",
+                "tau",
+                "skeleton",
+                "smooth",
+            ],
             Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax"],
             Solver::Ik(_) => &["ddim_steps", "iterations", "lr", "smoothness"],
             Solver::Lbfgs(_) => &[
@@ -129,6 +137,14 @@ impl Solver {
                 "k_late" => c.k_late = count()?,
                 "late_steps" => c.late_steps = count()?,
                 "tau" => c.tau = real()? as f32,
+                "smooth" => c.smooth_frames = real()? as f32,
+                "skeleton" => {
+                    c.keep_skeleton = match count()? {
+                        0 => false,
+                        1 => true,
+                        _ => return Err("`skeleton` is 0 (off) or 1 (keep bone lengths)".into()),
+                    }
+                }
                 _ => return Err(unknown()),
             },
             Solver::Latent(c) => match name {

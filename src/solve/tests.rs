@@ -557,6 +557,7 @@ fn fused_and_graph_guidance_agree() {
     let cfg = GuideConfig {
         steps: 10,
         k_late: 30,
+        keep_skeleton: false,
         ..GuideConfig::default()
     };
     let fused = run(
@@ -690,4 +691,124 @@ fn knobs_set_settings_and_unknown_ones_list_the_valid_names() {
     let mut ik = Solver::by_name("ik").unwrap();
     ik.set_knob("smoothness", 0.1).unwrap();
     assert_eq!(ik.name(), "ik-reg");
+}
+
+#[test]
+fn guide_keeps_the_skeleton_in_its_late_steps() {
+    use crate::skeleton::{BONE_LENGTHS, NUM_JOINTS, PARENTS};
+    let bundle = tiny_bundle();
+    // The tiny model's poses are random: its bones have no particular length.
+    let worst_bone = |r: &SolveResult| {
+        let mut worst = 0.0f32;
+        for f in &r.motions[0][0].frames {
+            for j in 1..NUM_JOINTS {
+                let l = (f[j] - f[PARENTS[j]]).length();
+                worst = worst.max((l - BONE_LENGTHS[j]).abs());
+            }
+        }
+        worst
+    };
+    let cfg = |keep_skeleton| GuideConfig {
+        steps: 50,
+        keep_skeleton,
+        ..GuideConfig::default()
+    };
+    let plain = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Guide(cfg(false)).unguided()),
+        &wrist_up,
+    );
+    let loose = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Guide(cfg(false))),
+        &wrist_up,
+    );
+    let kept = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Guide(cfg(true))),
+        &wrist_up,
+    );
+    assert!(
+        worst_bone(&loose) > 0.05,
+        "the tiny model already keeps bones"
+    );
+    assert!(
+        worst_bone(&kept) < 1e-3,
+        "bones off by {}",
+        worst_bone(&kept)
+    );
+    assert!(
+        kept.error[0] < 0.5 * plain.error[0],
+        "kept {} vs unguided {}",
+        kept.error[0],
+        plain.error[0]
+    );
+}
+
+/// Left wrist above 1.6 m at frame 8 only.
+fn wrist_up_at_8(j: Tensor<5>) -> Tensor<1> {
+    let [b, _, _, _, _] = j.dims();
+    let y = joint(j, 20).narrow(2, 8, 1).narrow(4, 1, 1);
+    (y.neg() + 1.6).clamp_min(0.0).reshape([b])
+}
+
+#[test]
+fn smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
+    let bundle = tiny_bundle();
+    let cfg = |smooth_frames| GuideConfig {
+        steps: 50,
+        smooth_frames,
+        ..GuideConfig::default()
+    };
+    let wrist_y =
+        |r: &SolveResult| -> Vec<f32> { r.motions[0][0].frames.iter().map(|f| f[20].y).collect() };
+    let plain = wrist_y(&run(
+        &bundle,
+        &request(&["a person walks"], Solver::Guide(cfg(0.0)).unguided()),
+        &wrist_up_at_8,
+    ));
+    // Largest frame-to-frame step of the edit (guided − unguided wrist height) around the
+    // keyframe, relative to the edit at the keyframe.
+    let jump = |smooth: f32| {
+        let r = run(
+            &bundle,
+            &request(&["a person walks"], Solver::Guide(cfg(smooth))),
+            &wrist_up_at_8,
+        );
+        assert!(r.error[0] < 0.05, "σ {smooth}: error {}", r.error[0]);
+        let edit: Vec<f32> = wrist_y(&r).iter().zip(&plain).map(|(a, b)| a - b).collect();
+        let step = (4..12)
+            .map(|t| (edit[t + 1] - edit[t]).abs())
+            .fold(0.0, f32::max);
+        step / edit[8].abs()
+    };
+    let (raw, smooth) = (jump(0.0), jump(3.0));
+    eprintln!("relative jump: raw {raw}, smoothed {smooth}");
+    assert!(
+        smooth < 0.7 * raw,
+        "relative jump: raw {raw}, smoothed {smooth}"
+    );
+}
+
+#[test]
+fn frame_smoothing_is_symmetric_and_off_at_zero() {
+    use super::guide::smooth_over_frames;
+    let (frames, width) = (12, 6);
+    let unit = |t: usize, c: usize| {
+        let mut v = vec![0.0; frames * width];
+        v[t * width + c] = 1.0;
+        v
+    };
+    assert_eq!(
+        smooth_over_frames(&unit(3, 1), frames, width, 0.0),
+        unit(3, 1)
+    );
+    // ⟨e_a, K e_b⟩ = ⟨K e_a, e_b⟩, and columns do not mix.
+    let (a, b) = (
+        smooth_over_frames(&unit(2, 0), frames, width, 2.0),
+        smooth_over_frames(&unit(5, 0), frames, width, 2.0),
+    );
+    assert!((a[5 * width] - b[2 * width]).abs() < 1e-6);
+    assert!(a.iter().skip(1).step_by(2).all(|v| *v == 0.0));
+    assert_eq!(a[2 * width], 1.0);
 }

@@ -4,10 +4,17 @@
 //!
 //! Only library calls whose geometry arguments fold to constants are drawn; anything that
 //! moves with the motion (a hand's distance to the other hand) is not geometry.
+//!
+//! A joint's coordinate bounded by a constant (`head.y < 0.8 m`, `j.x < 1 m`) is a plane
+//! too: horizontal for `.y`, a wall across the axis for `.x` and `.z`, when it holds on
+//! every frame. Bounds at some times only (`at mid { head.y < 0.5 m }`), under an `if`, or
+//! inside `or` / `not` are left out: they hold only somewhere, and a plane drawn across
+//! the whole scene and clip would say otherwise.
 
 use super::Checker;
-use super::values::{Cx, Env, Val};
-use crate::lang::syntax::ast::Expr;
+use super::values::{Cx, Env, Formula, Val};
+use crate::lang::ir::{NodeId, Op};
+use crate::lang::syntax::ast::{BinOp, Expr};
 use crate::render::Overlay;
 use crate::view::JointOf;
 use glam::Vec3;
@@ -47,6 +54,76 @@ impl<'a> Checker<'a> {
         {
             self.overlays.push(o);
         }
+    }
+}
+
+impl<'a> Checker<'a> {
+    /// Records the planes of a constraint's constant bounds on joint coordinates, if it
+    /// holds on every frame (`conditional`: it sits under an `if`).
+    pub(super) fn note_bounds(&mut self, f: &Formula, conditional: bool, cx: &Cx) {
+        // Domain 0 is every frame (the builder registers it first).
+        if conditional || cx.domain != 0 {
+            return;
+        }
+        match f {
+            Formula::And(x, y) => {
+                self.note_bounds(x, false, cx);
+                self.note_bounds(y, false, cx);
+            }
+            Formula::Cmp {
+                op: BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge,
+                a,
+                b,
+                ..
+            } => {
+                let bound = self
+                    .joint_axis(*a)
+                    .zip(self.scalar_const(*b))
+                    .or_else(|| self.joint_axis(*b).zip(self.scalar_const(*a)));
+                if let Some((axis, value)) = bound
+                    && let Some(o) = bound_plane(axis, value)
+                    && !self.overlays.contains(&o)
+                {
+                    self.overlays.push(o);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// The axis when `node` is one coordinate of joint positions.
+    fn joint_axis(&self, node: NodeId) -> Option<usize> {
+        match &self.b.nodes[node].op {
+            Op::Component { arg, axis } => matches!(
+                self.b.nodes[*arg].op,
+                Op::Gather { .. } | Op::MassCenter { .. }
+            )
+            .then_some(*axis),
+            _ => None,
+        }
+    }
+
+    fn scalar_const(&self, node: NodeId) -> Option<f32> {
+        self.b.const_of(node).and_then(scalar)
+    }
+}
+
+/// The plane `coordinate[axis] = value`; none for the floor itself.
+fn bound_plane(axis: usize, value: f32) -> Option<Overlay> {
+    if !value.is_finite() {
+        return None;
+    }
+    match axis {
+        1 if value.abs() > 1e-3 => Some(Overlay::HorizontalPlane { height: value }),
+        0 => Some(Overlay::VerticalPlane {
+            point: Vec3::new(value, 0.0, 0.0),
+            normal: Vec3::X,
+        }),
+        2 => Some(Overlay::VerticalPlane {
+            point: Vec3::new(0.0, 0.0, value),
+            normal: Vec3::Z,
+        }),
+        _ => None,
     }
 }
 
@@ -194,6 +271,34 @@ mod tests {
         let twice = overlays("dist(l_hand, [0, 1, 1]) < 5 cm\ndist(r_hand, [0, 1, 1]) < 5 cm");
         assert_eq!(twice.len(), 1);
     }
+
+    #[test]
+    fn constant_bounds_on_joint_coordinates_are_planes() {
+        assert_eq!(
+            overlays("head.y < 80 cm"),
+            [Overlay::HorizontalPlane { height: 0.8 }]
+        );
+        assert_eq!(
+            overlays("for j in joints { always { j.x < 1 m and j.z > -1 m } }"),
+            [
+                Overlay::VerticalPlane {
+                    point: Vec3::new(1.0, 0.0, 0.0),
+                    normal: Vec3::X
+                },
+                Overlay::VerticalPlane {
+                    point: Vec3::new(0.0, 0.0, -1.0),
+                    normal: Vec3::Z
+                }
+            ]
+        );
+        // Held only somewhere, only one of two, relative to the body, or the floor: no plane.
+        assert!(overlays("if head.z > 2 m { head.y < 0.8 m }").is_empty());
+        assert!(overlays("at 2s { head.y < 0.8 m }").is_empty());
+        assert_eq!(overlays("always { head.y < 2 m }").len(), 1);
+        assert!(overlays("head.y < 0.8 m or head.x > 1 m").is_empty());
+        assert!(overlays("l_hand.y > head.y").is_empty());
+        assert!(overlays("l_foot.y < 0 m").is_empty());
+    }
 }
 
 #[cfg(test)]
@@ -239,6 +344,14 @@ mod program_tests {
             of("fig1_inside_square.mprog")
                 .iter()
                 .any(|o| matches!(o, Overlay::Box { .. }))
+        );
+        // HSI-3 keeps every joint inside -1 < x, z < 1: four walls.
+        let walls = of("hsi3_square.mprog");
+        assert_eq!(walls.len(), 4, "{walls:?}");
+        assert!(
+            walls
+                .iter()
+                .all(|o| matches!(o, Overlay::VerticalPlane { .. }))
         );
     }
 }

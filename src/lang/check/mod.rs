@@ -302,7 +302,8 @@ pub fn module_to_ir<'a>(
                 "heights (`.y`, up) lie between -0.3 and 3 m; each person's pelvis starts at its \
                  start place (x = z = 0 with one person) and moves at most about 10 m/s. Check \
                  the axis and the direction of the comparison, and write places relative to the \
-                 start (`pelvis@start + [0, 0, 3]`)",
+                 start (`pelvis@start + [0, 0, 3]`). A number without a unit is in metres: \
+                 `head.y + 15` is 15 m higher; write `15 cm`",
             ),
         );
     }

@@ -152,6 +152,7 @@ impl<'a> Checker<'a> {
                 let w = self.weight(weight.as_ref(), &env, cx);
                 match self.expr(value, &env, cx) {
                     Val::Formula(f) => {
+                        self.note_bounds(&f, !scx.conds.is_empty(), cx);
                         let error = self.formula_error(&f);
                         self.emit(error, f.unit(), *span, scx.weight * w, false, scx);
                     }
