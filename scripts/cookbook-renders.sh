@@ -8,7 +8,7 @@
 # latent on a 2-core CPU (19 programs: about 50 minutes).
 # MPROG=path/to/mprog to use a built binary; ONLY=stem to render one program.
 set -euo pipefail
-mprog=${MPROG:-"cargo run --release --quiet --"}
+mprog=${MPROG:-"cargo run --quiet --"}
 out=book/src/images/cookbook
 mkdir -p "$out"
 for prog in programs/*.mprog; do

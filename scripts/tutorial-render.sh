@@ -3,7 +3,7 @@
 # hand-on-head program solved with guide, seed 1, shipped weights. Run from the
 # repository root. MPROG=path/to/mprog to use a built binary.
 set -euo pipefail
-mprog=${MPROG:-"cargo run --release --quiet --manifest-path $PWD/Cargo.toml --"}
+mprog=${MPROG:-"cargo run --quiet --manifest-path $PWD/Cargo.toml --"}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 cat > "$dir/hand_on_head.mprog" <<'PROGRAM'

@@ -387,23 +387,24 @@ fn apply_step(cfg: &GuideConfig, x: &mut [f32], g: &[f32], d: &[f32], values: &[
     }
 }
 
-/// Feature columns left unsmoothed: root yaw velocity, root XZ velocity, root height. The
-/// root's path integrates the first three, so a smoothed gradient there turns the whole
-/// walk (a dense "stay between two walls" stopped walking and turned on the spot).
-pub const UNSMOOTHED_COLUMNS: usize = 4;
-
-/// Each column of `[M, N, width]` rows from [`UNSMOOTHED_COLUMNS`] on, convolved over its
-/// N frames with a Gaussian of σ `sigma` frames (zero outside the motion, so the operator
-/// is symmetric and positive semi-definite and the result stays a descent direction); the
-/// root columns and everything with `sigma` 0 are returned unchanged.
+/// Each column of `[M, N, width]` rows convolved over its N frames with a Gaussian of σ
+/// `sigma` frames (zero outside the motion, so the operator is symmetric and positive
+/// semi-definite and the result stays a descent direction); `sigma` 0 returns `v`
+/// unchanged. Every column gets the same kernel.
 pub fn smooth_over_frames(v: &[f32], frames: usize, width: usize, sigma: f32) -> Vec<f32> {
     if sigma <= 0.0 || frames < 2 {
         return v.to_vec();
     }
     let radius = ((3.0 * sigma).ceil() as usize).min(frames - 1);
-    let kernel: Vec<f32> = (0..=radius)
+    // Weights sum to 1, so a gradient that is already smooth over time (a dense constraint)
+    // comes out as it went in: unnormalised, the Polyak step's cap on the largest change
+    // shrank with the kernel's mass and a dense error stopped falling (GEO-1's walker
+    // stayed through its wall).
+    let raw: Vec<f32> = (0..=radius)
         .map(|k| (-0.5 * (k as f32 / sigma).powi(2)).exp())
         .collect();
+    let mass = raw[0] + 2.0 * raw[1..].iter().sum::<f32>();
+    let kernel: Vec<f32> = raw.iter().map(|w| w / mass).collect();
     let mut out = vec![0.0; v.len()];
     for (src, dst) in v
         .chunks_exact(frames * width)
