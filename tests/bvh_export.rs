@@ -276,6 +276,22 @@ fn export_at_30_fps_keeps_the_motion() {
     };
     let err = bvh_string(&joints, &bad).unwrap_err();
     assert!(err.to_string().contains("cannot export at 0 fps"), "{err}");
+
+    // A non-finite position is refused with its frame and joint, at the source rate and
+    // after resampling alike.
+    let mut broken = joints.clone();
+    broken.frames[5][20].y = f32::NAN;
+    for fps in [None, Some(30.0)] {
+        let opts = BvhExportOptions {
+            fps,
+            ..BvhExportOptions::default()
+        };
+        let err = bvh_string(&broken, &opts).unwrap_err().to_string();
+        assert!(
+            err.contains("not finite") && err.contains("left_wrist"),
+            "{fps:?}: {err}"
+        );
+    }
 }
 
 /// Writes `[frames, 22, 3]` positions (Y up, metres) as a float32 `.npy`.

@@ -1,12 +1,13 @@
-//! The training loss's foot-contact term against a hand computation on the golden clip.
+//! The training loss's geometric terms (foot contact, velocity) against hand computations
+//! on the golden clip.
 
 mod common;
 
 use burn::prelude::*;
 use common::{golden, mean_std};
-use mprog::features::layout::CONTACT;
+use mprog::features::layout::{CONTACT, RIC};
 use mprog::features::{FEATURE_DIM, recover_from_ric};
-use mprog::model::train::FootLoss;
+use mprog::model::train::{FootLoss, VelocityLoss};
 use mprog::skeleton::{FOOT_LEFT, FOOT_RIGHT};
 
 fn normalised(feats: &[f32], mean: &[f32], std: &[f32]) -> Vec<f32> {
@@ -76,4 +77,51 @@ fn foot_term_is_the_mean_squared_slide_of_planted_feet_in_cm2() {
     let g = pred.grad(&grads).expect("gradient");
     let norm = g.abs().sum().into_scalar::<f32>();
     assert!(norm.is_finite() && norm > 0.0, "gradient norm {norm}");
+}
+
+#[test]
+fn velocity_term_counts_jitter_and_ignores_a_constant_offset() {
+    let (feats, _) = golden();
+    let (mean, std) = mean_std();
+    let n = feats.len() / FEATURE_DIM;
+    let dev = Device::flex();
+    let x0n = normalised(&feats, &mean, &std);
+    let tensor = |v: Vec<f32>| -> Tensor<3> {
+        Tensor::from_data(TensorData::new(v, [1, n, FEATURE_DIM]), &dev)
+    };
+    let valid: Tensor<3> = Tensor::ones([1, n, 1], &dev);
+    let vel = VelocityLoss::new(1.0, &std, &dev).expect("weight > 0");
+    let term = |pred: Vec<f32>| -> f64 {
+        vel.term(tensor(pred), tensor(x0n.clone()), valid.clone())
+            .into_scalar::<f32>() as f64
+    };
+    assert!(
+        term(x0n.clone()).abs() < 1e-9,
+        "a perfect prediction costs nothing"
+    );
+
+    // One joint coordinate 2 cm off on every frame: no velocity error.
+    let col = RIC.start;
+    let delta = 0.02f32;
+    let mut offset = x0n.clone();
+    for t in 0..n {
+        offset[t * FEATURE_DIM + col] += delta / std[col];
+    }
+    assert!(
+        term(offset).abs() < 1e-6,
+        "a constant offset has the data's velocity"
+    );
+
+    // The same error on one frame only: two frame pairs see a 2 cm step each.
+    let k = n / 2;
+    let mut spike = x0n.clone();
+    spike[k * FEATURE_DIM + col] += delta / std[col];
+    let per_joint = 2.0 * (100.0 * delta as f64).powi(2) / (64.0 / 3.0);
+    let expected = per_joint / n as f64; // n - 1 valid pairs, + 1 in the denominator
+    let got = term(spike);
+    assert!(
+        (got - expected).abs() < 1e-3 * expected,
+        "{got} vs {expected}"
+    );
+    assert!(VelocityLoss::new(0.0, &std, &dev).is_none());
 }

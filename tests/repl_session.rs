@@ -67,6 +67,29 @@ fn statements_accumulate_and_clear() {
 }
 
 #[test]
+fn drop_deletes_lines_unless_the_rest_no_longer_checks() {
+    let mut s = session();
+    say(&mut s, "length 2s");
+    say(&mut s, "param bar = 1.5 m");
+    say(&mut s, "head.y > bar");
+    say(&mut s, "always {\n  pelvis.z < 10 m\n}");
+    // Line 2 declares what line 3 uses: dropping it alone leaves an unknown name.
+    let refused = fails(&mut s, ":drop 2");
+    assert!(
+        refused.contains("not dropped") && refused.contains("bar"),
+        "{refused}"
+    );
+    assert_eq!(s.program().unwrap().statements().len(), 2);
+    // A block's closing brace alone is refused; its body, then the whole block, go.
+    fails(&mut s, ":drop 6");
+    assert!(say(&mut s, ":drop 5").contains("pelvis.z < 10 m"));
+    say(&mut s, ":drop 4-5");
+    say(&mut s, ":drop 2-3");
+    assert_eq!(s.source(), "length 2s\n");
+    assert!(fails(&mut s, ":drop 7").contains("1 line(s)"));
+}
+
+#[test]
 fn wrong_code_is_rejected_with_the_checkers_diagnostics() {
     let mut s = session();
     say(&mut s, "length 2s");

@@ -77,6 +77,9 @@ pub struct TrainConfig {
     /// Weight of the foot-contact velocity loss on recovered joints (0 disables).
     #[serde(default)]
     pub foot_loss: f64,
+    /// Weight of the velocity loss on the stored joint positions (0 disables).
+    #[serde(default)]
+    pub velocity_loss: f64,
     /// Seed of the data order and noise.
     pub seed: u64,
 }
@@ -96,6 +99,7 @@ impl Default for TrainConfig {
             steps: 100_000,
             checkpoint_every: 200,
             foot_loss: 0.0,
+            velocity_loss: 0.0,
             seed: 1,
         }
     }
@@ -161,6 +165,7 @@ impl TrainConfig {
         for (name, v) in [
             ("weight_decay", self.weight_decay),
             ("foot_loss", self.foot_loss),
+            ("velocity_loss", self.velocity_loss),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("`{name}` is {v}; it must be zero or positive"));

@@ -29,7 +29,7 @@ use super::weights::{
     save_bundle_parts,
 };
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
-use crate::features::layout::CONTACT;
+use crate::features::layout::{CONTACT, RIC, ROOT_Y};
 use crate::features::recover_from_ric_tensor;
 use crate::fsutil::write_bytes_atomic;
 use crate::interrupt::Interrupt;
@@ -197,23 +197,94 @@ impl FootLoss {
     }
 }
 
-/// Loss of one batch: the x0 MSE, plus the foot-contact term when `foot` is given.
+/// Velocity loss (MDM's L_vel) on the joint positions the features store (root height and
+/// the 21 root-relative joints): the squared error, in cm² per joint, of the predicted
+/// per-frame displacement against the data's, averaged over valid frame pairs. The x0 MSE
+/// treats every frame alone, so an undertrained model's errors are independent from frame
+/// to frame and show as jitter; this term penalises exactly that high-frequency part.
+pub struct VelocityLoss {
+    /// Weight of the term in the training loss.
+    pub weight: f32,
+    /// `[1, 1, 64]` feature std of the position block, to de-normalise the error (the
+    /// mean cancels in a difference).
+    pub std: Tensor<3>,
+}
+
+/// The feature columns the velocity loss reads: root height then the 21 joints' x, y, z.
+const POSITION_COLUMNS: std::ops::Range<usize> = ROOT_Y.start..RIC.end;
+
+impl VelocityLoss {
+    /// The loss for a dataset's statistics, or None when `weight` is 0.
+    pub fn new(weight: f64, std: &[f32], device: &Device) -> Option<Self> {
+        let cols = std[POSITION_COLUMNS].to_vec();
+        let len = cols.len();
+        (weight > 0.0).then(|| VelocityLoss {
+            weight: weight as f32,
+            std: Tensor::from_data(TensorData::new(cols, [1, 1, len]), device),
+        })
+    }
+
+    /// The term for normalised prediction and target `[B, N, 263]`, `valid` `[B, N, 1]`.
+    pub fn term(&self, pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+        let n = pred.dims()[1];
+        if n < 2 {
+            return Tensor::zeros([1], &pred.device());
+        }
+        let cols = POSITION_COLUMNS;
+        let err = (pred.narrow(2, cols.start, cols.len()) - x0.narrow(2, cols.start, cols.len()))
+            * self.std.clone()
+            * 100.0;
+        let step = err.clone().narrow(1, 1, n - 1) - err.narrow(1, 0, n - 1);
+        let both_valid = valid.clone().narrow(1, 0, n - 1) * valid.narrow(1, 1, n - 1);
+        // Sum over the columns / 3 = squared displacement error per joint (root height
+        // counts as a third of a joint).
+        let per_pair =
+            step.powi_scalar(2).sum_dim(2) * both_valid.clone() / (cols.len() as f32 / 3.0);
+        per_pair.sum() / (both_valid.sum() + 1.0)
+    }
+}
+
+/// The geometric terms added to the x0 MSE in training (each None when its weight is 0).
+#[derive(Default)]
+pub struct GeometricLosses {
+    /// MDM's foot-contact term.
+    pub foot: Option<FootLoss>,
+    /// MDM's velocity term.
+    pub velocity: Option<VelocityLoss>,
+}
+
+impl GeometricLosses {
+    /// The terms a training config asks for, with the dataset's statistics.
+    pub fn new(cfg: &TrainConfig, mean: &[f32], std: &[f32], device: &Device) -> Self {
+        GeometricLosses {
+            foot: FootLoss::new(cfg.foot_loss, mean, std, device),
+            velocity: VelocityLoss::new(cfg.velocity_loss, std, device),
+        }
+    }
+}
+
+/// Loss of one batch: the x0 MSE plus the geometric terms that are on.
 fn batch_loss(
     model: &Mdm,
     schedule: &NoiseSchedule,
     batch: &HostBatch,
     vocab: &Vocabulary,
-    foot: Option<&FootLoss>,
+    geometric: &GeometricLosses,
     device: &Device,
 ) -> Tensor<1> {
     let (mut input, x0, valid) = to_device(batch, vocab, device);
     input.x_t = q_sample(schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
     let pred = model.predict_x0(&input);
-    let mse = masked_mse(pred.clone(), x0.clone(), valid.clone());
-    match foot {
-        Some(f) => mse + f.term(pred, x0, valid).mul_scalar(f.weight),
-        None => mse,
+    let mut loss = masked_mse(pred.clone(), x0.clone(), valid.clone());
+    if let Some(f) = &geometric.foot {
+        loss = loss
+            + f.term(pred.clone(), x0.clone(), valid.clone())
+                .mul_scalar(f.weight);
     }
+    if let Some(v) = &geometric.velocity {
+        loss = loss + v.term(pred, x0, valid).mul_scalar(v.weight);
+    }
+    loss
 }
 
 /// Everything a run needs besides the model.
@@ -456,7 +527,8 @@ impl TrainRun<'_> {
         for r in 0..rounds {
             // Fixed "steps" far beyond any real step keep validation batches constant.
             let batch = draw_batch(self.data, &clips, &cfg, usize::MAX - r);
-            let loss = batch_loss(ema, schedule, &batch, vocab, None, device);
+            let none = GeometricLosses::default();
+            let loss = batch_loss(ema, schedule, &batch, vocab, &none, device);
             total += loss.into_scalar::<f32>() as f64;
         }
         Some(total / rounds as f64)
@@ -479,7 +551,7 @@ impl TrainRun<'_> {
         let device = plain.clone().autodiff();
         let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
         let mut ck = self.load_or_init(&vocab, &device, &plain)?;
-        let foot = FootLoss::new(cfg.foot_loss, &self.data.mean, &self.data.std, &device);
+        let geometric = GeometricLosses::new(cfg, &self.data.mean, &self.data.std, &device);
         let stop_at = match self.max_steps_now {
             Some(n) => (ck.state.step + n).min(cfg.steps),
             None => cfg.steps,
@@ -494,7 +566,7 @@ impl TrainRun<'_> {
             }
             let step = ck.state.step;
             let batch = draw_batch(self.data, &train, cfg, step);
-            let loss = batch_loss(&ck.model, &schedule, &batch, &vocab, foot.as_ref(), &device);
+            let loss = batch_loss(&ck.model, &schedule, &batch, &vocab, &geometric, &device);
             let value = loss.clone().into_scalar::<f32>();
             if !value.is_finite() {
                 return Err(TrainError::Diverged { step, loss: value });

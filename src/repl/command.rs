@@ -43,6 +43,13 @@ pub enum Command {
     Save(PathBuf),
     /// `:show`: print the session's program.
     Show,
+    /// `:drop N` or `:drop N-M`: delete lines of the session's program (1-based, inclusive).
+    Drop {
+        /// First line.
+        first: usize,
+        /// Last line.
+        last: usize,
+    },
     /// `:clear`: empty the session's program.
     Clear,
     /// `:help [command]`.
@@ -143,6 +150,12 @@ pub const COMMANDS: &[CommandDoc] = &[
         "",
         "print the session's program with line numbers",
     ),
+    doc(
+        "drop",
+        &["d"],
+        "LINE | FIRST-LAST",
+        "delete lines of the session's program (numbers as `:show` prints them)",
+    ),
     doc("clear", &[], "", "empty the session's program"),
     doc(
         "help",
@@ -223,6 +236,7 @@ fn parse_args(cmd: &CommandDoc, args: &str) -> Result<Command, String> {
         "grad" => need("a statement").map(Command::Grad),
         "gen" => parse_gen(args).map_err(|e| format!("{e}; {}", usage())),
         "run" => parse_run(args).map_err(|e| format!("{e}; {}", usage())),
+        "drop" => parse_drop(&need("a line number")?).map_err(|e| format!("{e}; {}", usage())),
         "score" => none(Command::Score),
         "show" => none(Command::Show),
         "clear" => none(Command::Clear),
@@ -262,6 +276,27 @@ fn parse_run(args: &str) -> Result<Command, String> {
         seed,
         knobs,
     })
+}
+
+fn parse_drop(args: &str) -> Result<Command, String> {
+    let line = |w: &str| -> Result<usize, String> {
+        w.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&n| n >= 1)
+            .ok_or_else(|| format!("`{}` is not a line number (1, 2, …)", w.trim()))
+    };
+    let (first, last) = match args.split_once('-') {
+        Some((a, b)) => (line(a)?, line(b)?),
+        None => {
+            let n = line(args)?;
+            (n, n)
+        }
+    };
+    if last < first {
+        return Err(format!("the range {first}-{last} runs backwards"));
+    }
+    Ok(Command::Drop { first, last })
 }
 
 fn parse_gen(args: &str) -> Result<Command, String> {
@@ -325,6 +360,11 @@ mod tests {
         assert_eq!(cmd(":e head.y"), Command::Eval("head.y".into()));
         assert_eq!(cmd(":grad head.y > 1"), Command::Grad("head.y > 1".into()));
         assert_eq!(cmd(":q"), Command::Quit);
+        assert_eq!(cmd(":drop 3"), Command::Drop { first: 3, last: 3 });
+        assert_eq!(cmd(":d 2-4"), Command::Drop { first: 2, last: 4 });
+        for bad in [":drop", ":drop 0", ":drop x", ":drop 4-2", ":drop 1-"] {
+            assert!(parse(bad).is_err(), "{bad}");
+        }
         assert_eq!(
             cmd(":run"),
             Command::Run {
@@ -410,6 +450,7 @@ mod tests {
         for c in COMMANDS {
             let line = match c.name {
                 "gen" => ":gen \"walk\"".to_string(),
+                "drop" => ":drop 1".to_string(),
                 _ if c.args.is_empty() || c.args.starts_with('[') => format!(":{}", c.name),
                 _ => format!(":{} x", c.name),
             };

@@ -99,6 +99,7 @@ impl Session {
             Command::View(path) => self.view(&path),
             Command::Save(path) => self.save(&path),
             Command::Show => Reply::text(self.show()),
+            Command::Drop { first, last } => self.drop_lines(first, last),
             Command::Clear => {
                 self.program.clear();
                 Reply::text("program cleared")
@@ -427,6 +428,38 @@ impl Session {
                 )
             }
         }
+    }
+
+    /// Deletes lines `first..=last` when what is left still checks; otherwise keeps the
+    /// program and shows why (e.g. a block's closing brace would be left alone).
+    fn drop_lines(&mut self, first: usize, last: usize) -> Reply {
+        let lines: Vec<&str> = self.program.lines().collect();
+        if last > lines.len() {
+            return Reply::error(format!(
+                "the program has {} line(s); `:show` numbers them",
+                lines.len()
+            ));
+        }
+        let kept: String = lines
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !(first - 1..last).contains(i))
+            .map(|(_, l)| format!("{l}\n"))
+            .collect();
+        let diags = visible(crate::lang::check_source(&kept, SOURCE_NAME, &[]));
+        if diags.has_errors() {
+            let mut reply = Reply::error(format!(
+                "not dropped: without line(s) {first}-{last} the program no longer checks (drop a whole block at once)"
+            ));
+            reply.push(Item::Diagnostics(diags));
+            return reply;
+        }
+        let gone: Vec<String> = lines[first - 1..last]
+            .iter()
+            .map(|l| format!("  {l}"))
+            .collect();
+        self.program = kept;
+        Reply::text(format!("dropped:\n{}", gone.join("\n")))
     }
 
     fn show(&self) -> String {
