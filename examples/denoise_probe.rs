@@ -13,8 +13,8 @@ use mprog::dataset::{Dataset, FEATURE_DIM, Split};
 use mprog::features::recover_from_ric;
 use mprog::model::ModelBundle;
 use mprog::model::denoiser::{Denoiser, DenoiserInput};
-use mprog::model::sampler::{Condition, ddim_step, guided_x0};
 use mprog::model::noise::NoiseSource;
+use mprog::model::sampler::{Condition, ddim_step, guided_x0};
 use mprog::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use mprog::model::text::TokenBatch;
 use mprog::motion::Motion;
@@ -86,8 +86,10 @@ fn main() {
     );
     println!("| t | √(1−ᾱ) | foot jitter of x̂0 | x̂0 MSE (normalised) |");
     println!("| --- | --- | --- | --- |");
-    let clean: Tensor<3> =
-        Tensor::from_data(TensorData::new(x0.clone(), [b, FRAMES, FEATURE_DIM]), &device);
+    let clean: Tensor<3> = Tensor::from_data(
+        TensorData::new(x0.clone(), [b, FRAMES, FEATURE_DIM]),
+        &device,
+    );
     for t in [0usize, 5, 20, 50, 100, 200, 400, 700] {
         let ab = schedule.alphas_cumprod[t];
         let eps = NoiseSource::new(7).tensor([b, FRAMES, FEATURE_DIM], &device);
@@ -125,7 +127,9 @@ fn main() {
             / b as f32
     };
     for scale in [1.0f32, 2.5] {
-        println!("\nDDIM 50 from noise, guidance {scale}: step t, jitter of x̂0, jitter of x_t read as a motion");
+        println!(
+            "\nDDIM 50 from noise, guidance {scale}: step t, jitter of x̂0, jitter of x_t read as a motion"
+        );
         let ddim = schedule.respaced(50);
         let cond = Condition::new(&bundle.vocab, &captions, scale, &device);
         let mut x = NoiseSource::new(1).tensor([b, FRAMES, FEATURE_DIM], &device);
@@ -140,7 +144,11 @@ fn main() {
                     jitter_of(x.clone() / ab.sqrt())
                 );
             }
-            x = if i > 0 { ddim_step(&ddim, i, x, pred) } else { pred };
+            x = if i > 0 {
+                ddim_step(&ddim, i, x, pred)
+            } else {
+                pred
+            };
         }
     }
 }

@@ -123,6 +123,7 @@ fn quick_task_bench_writes_a_table_for_the_chosen_solvers() {
     for needle in [
         "## PMG tasks",
         "## Two-person contact",
+        "| bones (m) |",
         "| guide |",
         "| plain |",
         "HSC-1",

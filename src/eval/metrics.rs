@@ -8,6 +8,8 @@
 //! * [`max_acceleration`]: max over joints and frames of ‖p[t+1] − 2p[t] + p[t−1]‖ (m/frame²).
 //! * [`bone_length_variation`]: std / mean of each bone's length over time, averaged over the
 //!   21 bones (0 for a rigid skeleton).
+//! * [`max_bone_error`]: the largest difference of any bone's length from the skeleton's
+//!   (m): how far a solver stretched the body to meet its constraints.
 //! * [`floor_penetration`]: per frame, how far the lowest joint is below y = 0.
 //!
 //! Descriptors of the training-baseline table (`notes/training-baseline.md`):
@@ -18,7 +20,7 @@
 //!   telling which hand a one-handed gesture used.
 
 use crate::motion::Motion;
-use crate::skeleton::{NUM_JOINTS, PARENTS};
+use crate::skeleton::{BONE_LENGTHS, NUM_JOINTS, PARENTS};
 use glam::Vec3;
 
 /// Feet used by the skating ratio (left foot, right foot).
@@ -120,6 +122,16 @@ pub fn bone_length_variation(m: &Motion) -> f32 {
     } else {
         (total / bones as f64) as f32
     }
+}
+
+/// Largest |bone length − the HumanML3D skeleton's| over bones and frames (m); 0 when empty.
+pub fn max_bone_error(m: &Motion) -> f32 {
+    m.frames
+        .iter()
+        .flat_map(|f| {
+            (1..NUM_JOINTS).map(move |j| ((f[j] - f[PARENTS[j]]).length() - BONE_LENGTHS[j]).abs())
+        })
+        .fold(0.0, f32::max)
 }
 
 /// Floor penetration of a motion.
@@ -372,6 +384,9 @@ mod tests {
         // That bone: mean 0.2, std 0.1 → 0.5; the other 20 bones: 0. Mean 0.5 / 21.
         approx(bone_length_variation(&m), 0.5 / 21.0, 1e-6);
         assert_eq!(bone_length_variation(&shifted(&[Vec3::ZERO; 4])), 0.0);
+        // The left forearm is 0.26601 m in the skeleton: 0.1 and 0.3 are 0.16601 and 0.03399 off.
+        approx(max_bone_error(&m), 0.26601 - 0.1, 1e-5);
+        approx(max_bone_error(&shifted(&[Vec3::ZERO; 4])), 0.0, 1e-5);
     }
 
     #[test]

@@ -13,7 +13,7 @@ pub mod keyframe;
 pub mod report;
 pub mod suite;
 
-use crate::eval::metrics::{foot_skating_ratio, max_acceleration};
+use crate::eval::metrics::{foot_skating_ratio, max_acceleration, max_bone_error};
 use crate::features::FEATURE_DIM;
 use crate::motion::Motion;
 use crate::solve::{Prior, Progress, SolveRequest, Solver, solve};
@@ -46,6 +46,8 @@ pub struct RunRow {
     pub skating: f32,
     /// Mean of the per-motion maximum joint acceleration (m/frame²).
     pub max_accel: f32,
+    /// Mean of the per-motion largest bone-length error against the skeleton (m).
+    pub bone_error: f32,
     /// Wall seconds per sample.
     pub seconds_per_sample: f64,
     /// Why the run failed (then the numbers are zero).
@@ -75,6 +77,7 @@ pub fn run_task(
         control: None,
         skating: 0.0,
         max_accel: 0.0,
+        bone_error: 0.0,
         seconds_per_sample: 0.0,
         failure: None,
         features: Vec::new(),
@@ -96,6 +99,7 @@ pub fn run_task(
     row.motions = all.len();
     row.skating = mean(all.iter().map(|m| foot_skating_ratio(m)));
     row.max_accel = mean(all.iter().map(|m| max_acceleration(m)));
+    row.bone_error = mean(all.iter().map(|m| max_bone_error(m)));
     row.seconds_per_sample = result.seconds / task.samples.max(1) as f64;
     let per_motion = task.frames * FEATURE_DIM;
     row.features = result

@@ -72,7 +72,8 @@ pub fn markdown(info: &RunInfo, rows: &[RunRow], realism: &Realism) -> String {
         md,
         "\nC.err: the program's total error (keyframes: mean distance, m). Unsuccess: share of \
          samples with any statement or keyframe error above 5 cm. Skating: PMG's foot-skating \
-         ratio. Accel: max joint acceleration (m/frame²). Realism: FID of the solver's motions \
+         ratio. Accel: max joint acceleration (m/frame²). Bones: largest bone-length error against \
+         the skeleton (m; a solver that stretches limbs to meet a constraint shows here). Realism: FID of the solver's motions \
          against held-out test clips (the evaluator of `mprog eval`; motions in brackets; few \
          motions make it noisy). Lower is better everywhere."
     );
@@ -110,12 +111,12 @@ fn summary(md: &mut String, family: Family, rows: &[&RunRow], realism: &Realism)
     if keyframe {
         let _ = writeln!(
             md,
-            "| solver | avg err (m) | traj err | loc err | unsuccess | skating | accel | realism (FID) | s/sample |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+            "| solver | avg err (m) | traj err | loc err | unsuccess | skating | accel | bones (m) | realism (FID) | s/sample |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
         );
     } else {
         let _ = writeln!(
             md,
-            "| solver | C.err | unsuccess | skating | accel | realism (FID) | s/sample |\n| --- | --- | --- | --- | --- | --- | --- |"
+            "| solver | C.err | unsuccess | skating | accel | bones (m) | realism (FID) | s/sample |\n| --- | --- | --- | --- | --- | --- | --- | --- |"
         );
     }
     for solver in solvers_in_order(rows) {
@@ -133,9 +134,10 @@ fn summary(md: &mut String, family: Family, rows: &[&RunRow], realism: &Realism)
             .sum::<f64>()
             / rs.iter().filter(|r| r.failure.is_none()).count().max(1) as f64;
         let tail = format!(
-            "{:.3} | {:.3} | {} | {secs:.1} |",
+            "{:.3} | {:.3} | {:.3} | {} | {secs:.1} |",
             avg(&rs, |r| r.skating),
             avg(&rs, |r| r.max_accel),
+            avg(&rs, |r| r.bone_error),
             realism_cell(realism, family, &solver)
         );
         if keyframe {
