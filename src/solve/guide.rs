@@ -35,8 +35,12 @@
 //!   prose says the opposite end). With a respaced chain "the last T_s steps" means the
 //!   last T_s steps of that chain (so the total inner-iteration count stays K_e·(n−T_s) +
 //!   K_l·T_s).
-//! * The gradient of every feature of frame 0 is zeroed (the code indexes the frame axis
-//!   while its comment speaks of the root); [`GuideConfig::freeze_first_frame`].
+//! * The code zeroes the gradient of every feature of frame 0 (it indexes the frame axis
+//!   while its comment speaks of the root, which `recover_from_ric` pins at the origin
+//!   anyway). **Not followed by default** ([`GuideConfig::freeze_first_frame`], knob
+//!   `freeze=1`): a constraint on the first frame could then never be met (HOI-1's pick
+//!   stayed 0.36 m off) and the late-step smoothing, which spreads that frame's gradient to
+//!   its neighbours, moved frame 1 without frame 0: a 0.87 m jump of the wrist in one frame.
 //!
 //! **Step size that transfers between programs.** OmniControl differentiates
 //! G = Σ_{n,j} ‖p_{n,j} − c_{n,j}‖ (a sum over the V controlled frames of each joint) and
@@ -109,7 +113,8 @@ pub struct GuideConfig {
     pub variance_rule: VarianceRule,
     /// Step size rule.
     pub step_rule: StepRule,
-    /// Zero the gradient of frame 0 (the reference code does).
+    /// Zero the gradient of frame 0 (the reference code does; off by default, see the
+    /// module notes).
     pub freeze_first_frame: bool,
     /// Evaluate the inner loop through the fused host FK (fast); `false` runs it through the
     /// burn graph (the reference, for tests and checks).
@@ -134,7 +139,7 @@ impl Default for GuideConfig {
             variance_bound: 0.01,
             variance_rule: VarianceRule::Floor,
             step_rule: StepRule::Polyak,
-            freeze_first_frame: true,
+            freeze_first_frame: false,
             fused: true,
             keep_skeleton: true,
             smooth_frames: 4.0,

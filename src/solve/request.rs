@@ -90,6 +90,7 @@ impl Solver {
                 "late_steps",
                 "tau",
                 "skeleton",
+                "freeze",
                 "smooth",
             ],
             Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax"],
@@ -143,6 +144,13 @@ impl Solver {
                         0 => false,
                         1 => true,
                         _ => return Err("`skeleton` is 0 (off) or 1 (keep bone lengths)".into()),
+                    }
+                }
+                "freeze" => {
+                    c.freeze_first_frame = match count()? {
+                        0 => false,
+                        1 => true,
+                        _ => return Err("`freeze` is 0 (off) or 1 (first frame frozen)".into()),
                     }
                 }
                 _ => return Err(unknown()),

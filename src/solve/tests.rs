@@ -790,6 +790,41 @@ fn smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
     );
 }
 
+/// Left wrist above 1.6 m on frame 0.
+fn wrist_up_at_start(j: Tensor<5>) -> Tensor<1> {
+    let [b, _, _, _, _] = j.dims();
+    let y = joint(j, 20).narrow(2, 0, 1).narrow(4, 1, 1);
+    (y.neg() + 1.6).clamp_min(0.0).reshape([b])
+}
+
+#[test]
+fn a_first_frame_target_is_met_unless_the_frame_is_frozen() {
+    let bundle = tiny_bundle();
+    let solve = |freeze_first_frame| {
+        let cfg = GuideConfig {
+            steps: 50,
+            freeze_first_frame,
+            ..GuideConfig::default()
+        };
+        run(
+            &bundle,
+            &request(&["a person walks"], Solver::Guide(cfg)),
+            &wrist_up_at_start,
+        )
+    };
+    let (free, frozen) = (solve(false), solve(true));
+    let wrist = |r: &SolveResult, t: usize| r.motions[0][0].frames[t][20];
+    eprintln!(
+        "frame-0 error: free {}, frozen {}",
+        free.error[0], frozen.error[0]
+    );
+    assert!(free.error[0] < 0.02, "free: {}", free.error[0]);
+    assert!(frozen.error[0] > 0.1, "frozen: {}", frozen.error[0]);
+    // Unfrozen, frames 0 and 1 move together: no jump between them.
+    let step = (wrist(&free, 1) - wrist(&free, 0)).length();
+    assert!(step < 0.15, "wrist moves {step} m from frame 0 to 1");
+}
+
 #[test]
 fn frame_smoothing_is_symmetric_and_off_at_zero() {
     use super::guide::smooth_over_frames;
