@@ -63,6 +63,10 @@ fn knobs_reach_the_solver_and_the_saved_meta() {
         "{stderr}"
     );
     assert!(!stderr.contains("line 4: already"), "{stderr}");
+    assert!(
+        stderr.contains("body: bone lengths within") && stderr.contains("foot skating"),
+        "{stderr}"
+    );
     let meta = std::fs::read_to_string(&json).unwrap();
     assert!(
         meta.contains("\"knobs\"") && meta.contains("k_late"),

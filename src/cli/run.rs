@@ -15,6 +15,24 @@ use mprog::motion::Motion;
 use mprog::solve::{Prior, Progress, SolveRequest, SolveResult, Solver, solve};
 use std::path::PathBuf;
 
+/// One line on how physical the result is: a solver that stretched limbs, shook joints or
+/// slid the feet to meet the program shows here (the numbers `mprog bench tasks` reports).
+fn body_summary(people: &[Motion]) -> String {
+    use mprog::eval::metrics::{foot_skating_ratio, max_acceleration, max_bone_error};
+    let worst = |f: fn(&Motion) -> f32| people.iter().map(f).fold(0.0, f32::max);
+    format!(
+        "body: bone lengths within {:.1} cm of the skeleton's, foot skating {:.2}, max joint acceleration {:.3} m/frame²{}",
+        100.0 * worst(max_bone_error),
+        worst(foot_skating_ratio),
+        worst(max_acceleration),
+        if people.len() > 1 {
+            " (worst person)"
+        } else {
+            ""
+        }
+    )
+}
+
 /// Arguments of `mprog run`.
 #[derive(clap::Args)]
 pub struct RunArgs {
@@ -191,6 +209,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         ),
         None => eprintln!("{}: {:.1} s", solver.name(), result.seconds),
     }
+    eprintln!("{}", body_summary(people));
     let mut meta = Meta::new();
     meta.insert(
         "program".into(),
