@@ -10,7 +10,7 @@
 
 use burn::prelude::*;
 use mprog::dataset::{Dataset, FEATURE_DIM, Split};
-use mprog::features::recover_from_ric;
+use mprog::features::{denormalize_slice, normalize_slice, recover_from_ric};
 use mprog::model::ModelBundle;
 use mprog::model::denoiser::{Denoiser, DenoiserInput};
 use mprog::model::noise::NoiseSource;
@@ -55,16 +55,14 @@ fn main() {
     let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
     let (mean, std) = (&bundle.mean, &bundle.std);
     let normalise = |raw: &[f32]| -> Vec<f32> {
-        raw.iter()
-            .enumerate()
-            .map(|(i, v)| (v - mean[i % FEATURE_DIM]) / std[i % FEATURE_DIM])
-            .collect()
+        let mut v = raw.to_vec();
+        normalize_slice(&mut v, mean, std).expect("feature rows");
+        v
     };
     let denormalise = |n: &[f32]| -> Vec<f32> {
-        n.iter()
-            .enumerate()
-            .map(|(i, v)| v * std[i % FEATURE_DIM] + mean[i % FEATURE_DIM])
-            .collect()
+        let mut v = n.to_vec();
+        denormalize_slice(&mut v, mean, std).expect("feature rows");
+        v
     };
     let b = clips.len();
     let mut x0 = Vec::with_capacity(b * FRAMES * FEATURE_DIM);

@@ -745,11 +745,15 @@ fn guide_keeps_the_skeleton_in_its_late_steps() {
     );
 }
 
-/// Left wrist above 1.6 m at frame 8 only.
-fn wrist_up_at_8(j: Tensor<5>) -> Tensor<1> {
+/// Left wrist above 1.6 m on one frame only.
+fn wrist_up_on(frame: usize, j: Tensor<5>) -> Tensor<1> {
     let [b, _, _, _, _] = j.dims();
-    let y = joint(j, 20).narrow(2, 8, 1).narrow(4, 1, 1);
+    let y = joint(j, 20).narrow(2, frame, 1).narrow(4, 1, 1);
     (y.neg() + 1.6).clamp_min(0.0).reshape([b])
+}
+
+fn wrist_up_at_8(j: Tensor<5>) -> Tensor<1> {
+    wrist_up_on(8, j)
 }
 
 #[test]
@@ -790,11 +794,8 @@ fn smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
     );
 }
 
-/// Left wrist above 1.6 m on frame 0.
 fn wrist_up_at_start(j: Tensor<5>) -> Tensor<1> {
-    let [b, _, _, _, _] = j.dims();
-    let y = joint(j, 20).narrow(2, 0, 1).narrow(4, 1, 1);
-    (y.neg() + 1.6).clamp_min(0.0).reshape([b])
+    wrist_up_on(0, j)
 }
 
 #[test]
