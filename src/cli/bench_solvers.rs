@@ -115,6 +115,8 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
             Solver::Guide(GuideConfig {
                 fused: false,
                 keep_skeleton: false,
+                foot_lock: 0.0,
+                early_root_only: false,
                 ..guide.clone()
             }),
             "guide (burn autodiff tape, skeleton=0)",

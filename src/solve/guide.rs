@@ -24,6 +24,23 @@
 //! answers every edit, and smoothed edits of every frame's pose led it elsewhere (a walk
 //! between two close walls stopped walking).
 //!
+//! Before the last T_s steps only the root columns move (mprog's addition, on by default:
+//! [`GuideConfig::early_root_only`]). OmniControl edits every column of μ from the first
+//! step, and this prior answers edited poses with its data: the training set has no walk
+//! with a hand held up, so a walk whose wrist the guide kept on the head came back as a
+//! standing pose carried along by the walk's root velocity, a statue gliding 11–17 m with
+//! its feet still ("walks with the left hand on the head", HSC-1). Steering only the path
+//! early leaves the gait to the denoiser; the late steps then place the limbs on the
+//! walking body. Errors that depend on the path (reach a point, stay in a square) still
+//! act from the first step. The root moves by the step the whole gradient calls for: sized
+//! from the root's share alone, a pose error with a small root gradient pushed the root
+//! height by metres and the walker stopped.
+//!
+//! In the same last T_s steps planted feet are held (mprog's addition,
+//! [`GuideConfig::foot_lock`], [`super::feet`]): the step also reduces the slide of toes
+//! that are on the floor, so a constraint met by moving the root moves the legs with it.
+//! On the walking programs it halves the skating of the result at the same program error.
+//!
 //! The denoiser is not in the inner loop: only FK, the error and its gradient are, through
 //! the fused host path ([`super::host`]) by default.
 //!
@@ -91,6 +108,9 @@ pub enum StepRule {
     Polyak,
 }
 
+/// Root columns of a feature row: yaw velocity, XZ velocity, height.
+const ROOT_COLUMNS: usize = 4;
+
 /// Largest change of one normalised feature in one Polyak iteration.
 pub const MAX_POLYAK_DELTA: f32 = 0.5;
 
@@ -126,6 +146,13 @@ pub struct GuideConfig {
     /// σ in frames of the Gaussian the gradient is smoothed with over time before each
     /// step of the last `late_steps` steps (0: OmniControl's raw gradient).
     pub smooth_frames: f32,
+    /// Weight of the slide penalty on planted feet in the last `late_steps` steps
+    /// ([`super::feet`]); 0 turns it off. Needs the fused path.
+    pub foot_lock: f32,
+    /// Before the last `late_steps` steps, step only the root columns (yaw velocity, XZ
+    /// velocity, height): the path is steered while the denoiser keeps the pose its own
+    /// (see the module notes). Needs the fused path.
+    pub early_root_only: bool,
 }
 
 impl Default for GuideConfig {
@@ -143,6 +170,8 @@ impl Default for GuideConfig {
             fused: true,
             keep_skeleton: true,
             smooth_frames: 4.0,
+            foot_lock: 1.0,
+            early_root_only: true,
         }
     }
 }
@@ -163,6 +192,22 @@ impl GuideConfig {
         if !(self.smooth_frames.is_finite() && (0.0..=100.0).contains(&self.smooth_frames)) {
             return Err(SolveError::Invalid(
                 "guide: smooth_frames (σ of the gradient's smoothing over time) must be between 0 and 100 frames".into(),
+            ));
+        }
+        if !(self.foot_lock.is_finite() && self.foot_lock >= 0.0) {
+            return Err(SolveError::Invalid(
+                "guide: the foot lock's weight must be finite and ≥ 0".into(),
+            ));
+        }
+        if self.foot_lock > 0.0 && !self.fused {
+            return Err(SolveError::Invalid(
+                "guide: the foot lock needs the fused inner loop (set fused or the foot lock to 0)"
+                    .into(),
+            ));
+        }
+        if self.early_root_only && !self.fused {
+            return Err(SolveError::Invalid(
+                "guide: early root-only steps need the fused inner loop (set fused or early_root to 0)".into(),
             ));
         }
         if self.keep_skeleton && !self.fused {
@@ -233,8 +278,13 @@ pub(crate) fn run(
         if k > 0 {
             let mut full = host(mu);
             let values = if cfg.fused {
-                let skeleton = cfg.keep_skeleton && i < cfg.late_steps;
-                let inner = Inner { k, step, skeleton };
+                let late = i < cfg.late_steps;
+                let inner = Inner {
+                    k,
+                    step,
+                    skeleton: cfg.keep_skeleton && late,
+                    foot_lock: if late { cfg.foot_lock } else { 0.0 },
+                };
                 guide_fused(ctx, cfg, &mut objective, &mut full, inner, i, &at)?
             } else {
                 guide_graph(ctx, cfg, &mut full, k, step, i, &at)?
@@ -263,12 +313,13 @@ pub(crate) fn run(
 }
 
 /// One denoising step's inner loop: K iterations of this step size, through the skeleton
-/// projection or not.
+/// projection or not, with or without the foot lock (weight 0: without).
 #[derive(Clone, Copy)]
 struct Inner {
     k: usize,
     step: f32,
     skeleton: bool,
+    foot_lock: f32,
 }
 
 /// K steps on the head columns of `full` through the fused host path; returns the error
@@ -278,7 +329,12 @@ fn guide_fused(
     cfg: &GuideConfig,
     objective: &mut HostObjective,
     full: &mut [f32],
-    Inner { k, step, skeleton }: Inner,
+    Inner {
+        k,
+        step,
+        skeleton,
+        foot_lock,
+    }: Inner,
     i: usize,
     at: &dyn Fn(usize) -> String,
 ) -> Result<Vec<f32>, SolveError> {
@@ -289,8 +345,16 @@ fn guide_fused(
     if skeleton {
         objective.project_skeleton(&head);
     }
+    if foot_lock > 0.0 {
+        objective.lock_feet(&head, foot_lock);
+    }
+    let mut total = Vec::new();
     for it in 0..k {
         values = objective.eval(&head, &mut grad)?;
+        // The step removes a fraction of program error + foot penalty, whose gradient
+        // `grad` is; the program's own error is what gets reported.
+        total.clear();
+        total.extend(values.iter().zip(objective.penalty()).map(|(e, p)| e + p));
         ensure_finite(&values, "guide", "error", || at(it))?;
         ensure_finite(&grad, "guide", "gradient", || at(it))?;
         let mut dir = smooth_over_frames(&grad, ctx.frames, HEAD, sigma);
@@ -301,8 +365,17 @@ fn guide_fused(
                 dir[f0..f0 + HEAD].fill(0.0);
             }
         }
-        apply_step(cfg, &mut head, &grad, &dir, &values, step);
+        // Early root-only steps take the step the full gradient calls for, on the root
+        // columns alone: restricting the direction must not enlarge the step (a pose error
+        // with a small root gradient would otherwise push the root height by metres).
+        let moving = if cfg.early_root_only && i >= cfg.late_steps {
+            ROOT_COLUMNS
+        } else {
+            HEAD
+        };
+        apply_step(cfg, &mut head, &grad, &dir, &total, step, (HEAD, moving));
     }
+    objective.unlock_feet();
     if skeleton {
         // The error was of P(head): make that what the chain carries on with.
         objective.apply_projection(&mut head);
@@ -351,19 +424,40 @@ fn guide_graph(
                 dir[f0..f0 + FEATURE_DIM].fill(0.0);
             }
         }
-        apply_step(cfg, full, &g, &dir, &values, step);
+        apply_step(
+            cfg,
+            full,
+            &g,
+            &dir,
+            &values,
+            step,
+            (FEATURE_DIM, FEATURE_DIM),
+        );
     }
     Ok(values)
 }
 
 /// `x ← x − s·d` along direction `d` (the gradient `g`, smoothed or not) with `s` from the
 /// step rule; `x`, `g` and `d` hold the samples one after the other (equal blocks),
-/// `values` their errors. The linearised error drops by `s·⟨g, d⟩`.
-fn apply_step(cfg: &GuideConfig, x: &mut [f32], g: &[f32], d: &[f32], values: &[f32], step: f32) {
+/// `values` their errors. The linearised error drops by `s·⟨g, d⟩`. `(width, moving)`:
+/// rows are `width` wide and only their first `moving` columns change; `s` is the one the
+/// whole direction calls for.
+fn apply_step(
+    cfg: &GuideConfig,
+    x: &mut [f32],
+    g: &[f32],
+    d: &[f32],
+    values: &[f32],
+    step: f32,
+    (width, moving): (usize, usize),
+) {
+    let moves = |k: usize| k % width < moving;
     match cfg.step_rule {
         StepRule::Gradient => {
-            for (x, d) in x.iter_mut().zip(d) {
-                *x -= step * d;
+            for (k, (x, d)) in x.iter_mut().zip(d).enumerate() {
+                if moves(k) {
+                    *x -= step * d;
+                }
             }
         }
         StepRule::Polyak => {
@@ -382,10 +476,19 @@ fn apply_step(cfg: &GuideConfig, x: &mut [f32], g: &[f32], d: &[f32], values: &[
                 if slope <= 1e-20 || e <= 0.0 {
                     continue;
                 }
-                let d_max = db.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+                let d_max = db
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| moves(*k))
+                    .fold(0.0f32, |m, (_, v)| m.max(v.abs()));
+                if d_max == 0.0 {
+                    continue;
+                }
                 let s = ((fraction * e as f64 / slope) as f32).min(MAX_POLYAK_DELTA / d_max);
-                for (x, d) in xb.iter_mut().zip(db) {
-                    *x -= s * d;
+                for (k, (x, d)) in xb.iter_mut().zip(db).enumerate() {
+                    if moves(k) {
+                        *x -= s * d;
+                    }
                 }
             }
         }

@@ -17,6 +17,7 @@
 
 use super::bones::SkeletonProjection;
 use super::decode::Decoder;
+use super::feet::FootLock;
 use super::place::Placement;
 use super::{MotionError, SolveError};
 use crate::features::layout::RIC;
@@ -148,6 +149,10 @@ pub struct HostObjective<'a> {
     joints: Vec<f32>,
     /// Skeleton projection applied before the FK ([`Self::project_skeleton`]).
     projection: Option<SkeletonProjection>,
+    /// Slide penalty on planted feet ([`Self::lock_feet`]).
+    feet: Option<FootLock>,
+    /// That penalty per sample at the last evaluation (zeros without it).
+    penalty: Vec<f32>,
 }
 
 impl<'a> HostObjective<'a> {
@@ -172,7 +177,33 @@ impl<'a> HostObjective<'a> {
             head: Vec::new(),
             joints: Vec::new(),
             projection: None,
+            feet: None,
+            penalty: vec![0.0; batch],
         }
+    }
+
+    /// From now on add [`FootLock`]'s penalty (weight `weight`) on the feet that are planted
+    /// in these normalised heads (after the skeleton projection, if one is set up) to what
+    /// [`eval`](Self::eval) differentiates; returns how many toe-frame pairs are planted.
+    pub fn lock_feet(&mut self, head: &[f32], weight: f32) -> usize {
+        let people = self.placements.len();
+        let joints = self.world_joints(head).to_vec();
+        let lock = FootLock::new(&joints, self.frames, people, weight);
+        let planted = lock.planted();
+        self.feet = Some(lock);
+        planted
+    }
+
+    /// Stop adding the foot penalty.
+    pub fn unlock_feet(&mut self) {
+        self.feet = None;
+        self.penalty.fill(0.0);
+    }
+
+    /// The foot penalty per sample at the last [`eval`](Self::eval): its gradient is in
+    /// that evaluation's gradient, its value is not in the returned errors.
+    pub fn penalty(&self) -> &[f32] {
+        &self.penalty
     }
 
     /// From now on evaluate the error of `P(head)`, the skeleton projection set up on these
@@ -246,8 +277,9 @@ impl<'a> HostObjective<'a> {
         &self.joints
     }
 
-    /// Errors per sample `[B]`; writes `∂(Σ_b error_b)/∂head` (normalised) into `grad`.
-    /// Values are returned as computed (the caller checks them for NaN/Inf).
+    /// Errors per sample `[B]`; writes `∂(Σ_b error_b + penalty_b)/∂head` (normalised) into
+    /// `grad`, where the penalty is the foot lock's, if set ([`Self::penalty`]). Values are
+    /// returned as computed (the caller checks them for NaN/Inf).
     pub fn eval(&mut self, head: &[f32], grad: &mut [f32]) -> Result<Vec<f32>, SolveError> {
         let people = self.placements.len();
         self.world_joints(head);
@@ -268,10 +300,17 @@ impl<'a> HostObjective<'a> {
         } else {
             None
         };
-        let Some(mut g) = g_world else {
-            grad.fill(0.0);
-            return Ok(values);
+        let mut g = match (g_world, &self.feet) {
+            (Some(g), _) => g,
+            (None, Some(_)) => vec![0.0; self.joints.len()],
+            (None, None) => {
+                grad.fill(0.0);
+                return Ok(values);
+            }
         };
+        if let Some(lock) = &self.feet {
+            self.penalty = lock.eval(&self.joints, &mut g);
+        }
         // Undo the placement (Rᵀ), then the FK, then the de-normalisation.
         let per = self.frames * NUM_JOINTS * 3;
         for (i, chunk) in g.chunks_exact_mut(per).enumerate() {

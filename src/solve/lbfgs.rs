@@ -10,11 +10,18 @@
 //!
 //! Defaults: k_first = 2, k_last = 10, T_s = 10 (InterControl's parser defaults; its
 //! two-person sampler hard-codes k_first = 1, its README evaluation uses 5).
+//!
+//! In the last T_s steps it keeps the skeleton, as `guide` does (mprog's addition, on by
+//! default: [`LbfgsConfig::keep_skeleton`]): L-BFGS minimises `E(P(μ))` through the fused
+//! host path and `P(μ)` is written back ([`super::bones`]). InterControl's model was
+//! trained with joint-position losses; this one's features hold each joint on its own, and
+//! without the projection the late steps meet a contact by stretching an arm.
 
 use super::SolveError;
-use super::host::check_shape;
+use super::host::{HostObjective, check_shape, extract_head, insert_head};
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
+use crate::features::FEATURE_DIM;
 use crate::model::sampler::{guided_x0, posterior_mean};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use burn::module::Param;
@@ -39,6 +46,9 @@ pub struct LbfgsConfig {
     pub max_iter: usize,
     /// Learning rate (1.0).
     pub lr: f64,
+    /// In the last `late_steps` steps, optimise through the skeleton projection and write
+    /// it back, as `guide` does.
+    pub keep_skeleton: bool,
 }
 
 impl Default for LbfgsConfig {
@@ -51,6 +61,7 @@ impl Default for LbfgsConfig {
             history: 10,
             max_iter: 4,
             lr: 1.0,
+            keep_skeleton: true,
         }
     }
 }
@@ -93,6 +104,13 @@ pub(crate) fn run(
         .with_history_size(cfg.history)
         .with_max_iter(cfg.max_iter)
         .with_line_search_fn(LineSearchFn::StrongWolfe);
+    let mut objective = HostObjective::new(
+        ctx.error,
+        &ctx.decoder,
+        ctx.samples,
+        ctx.frames,
+        &ctx.device,
+    );
     let mut x = ctx.initial_tensor(&ctx.device);
     let mut trace = Vec::with_capacity(n);
     for i in (0..n).rev() {
@@ -104,6 +122,10 @@ pub(crate) fn run(
             cfg.k_first
         };
         let at = || format!("denoising step {}/{n}", n - i);
+        let skeleton = cfg.keep_skeleton && i < cfg.late_steps && k > 0;
+        if skeleton {
+            objective.project_skeleton(&extract_head(&host(mu.clone()), FEATURE_DIM));
+        }
         let mut module = Mu {
             x: Param::from_tensor(Tensor::from_data(mu.into_data(), &ad).require_grad()),
         };
@@ -112,8 +134,39 @@ pub(crate) fn run(
         let mut last: Vec<f32> = Vec::new();
         for _ in 0..k {
             let mut closure = |m: Mu| -> (f64, GradientsParams) {
-                let e = ctx.error.error(ctx.decoder.joints(m.x.val(), None));
                 let mut grads = GradientsParams::new();
+                if skeleton {
+                    // E(P(μ)) and its gradient through the fused host path.
+                    let full = host(m.x.val().detach());
+                    let head = extract_head(&full, FEATURE_DIM);
+                    let mut g_head = vec![0.0; head.len()];
+                    let value = match objective.eval(&head, &mut g_head) {
+                        Ok(values) => {
+                            let sum = values.iter().map(|&v| v as f64).sum::<f64>();
+                            if !sum.is_finite() {
+                                bad.set(Some(SolveError::NonFinite {
+                                    solver: "lbfgs",
+                                    what: "error",
+                                    at: at(),
+                                }));
+                            }
+                            last = values;
+                            sum
+                        }
+                        Err(err) => {
+                            bad.set(Some(err));
+                            f64::NAN
+                        }
+                    };
+                    let mut g = vec![0.0; full.len()];
+                    insert_head(&mut g, FEATURE_DIM, &g_head);
+                    grads.register(
+                        m.x.id,
+                        Tensor::<3>::from_data(TensorData::new(g, dims), &ctx.device),
+                    );
+                    return (value, grads);
+                }
+                let e = ctx.error.error(ctx.decoder.joints(m.x.val(), None));
                 if let Err(err) = check_shape(&e, ctx.samples) {
                     bad.set(Some(err));
                     grads.register(m.x.id, Tensor::<3>::zeros(dims, &ctx.device));
@@ -148,7 +201,16 @@ pub(crate) fn run(
             }
             ensure_finite(&[loss as f32], "lbfgs", "error", at)?;
         }
-        let mu = Tensor::<3>::from_data(module.x.val().detach().into_data(), &ctx.device);
+        let mut mu = Tensor::<3>::from_data(module.x.val().detach().into_data(), &ctx.device);
+        if skeleton {
+            // The error was of P(μ): make that what the chain carries on with.
+            let mut full = host(mu);
+            let mut head = extract_head(&full, FEATURE_DIM);
+            objective.apply_projection(&mut head);
+            objective.stop_projecting();
+            insert_head(&mut full, FEATURE_DIM, &head);
+            mu = Tensor::from_data(TensorData::new(full, dims), &ctx.device);
+        }
         let values = if k > 0 {
             ensure_finite(&last, "lbfgs", "error", at)?;
             trace.push(last.clone());

@@ -42,6 +42,7 @@
 pub mod adam;
 pub mod bones;
 mod decode;
+pub mod feet;
 pub mod guide;
 pub mod host;
 pub mod ik;

@@ -92,6 +92,8 @@ impl Solver {
                 "skeleton",
                 "freeze",
                 "smooth",
+                "feet",
+                "early_root",
             ],
             Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax"],
             Solver::Ik(_) => &["ddim_steps", "iterations", "lr", "smoothness"],
@@ -103,6 +105,7 @@ impl Solver {
                 "history",
                 "max_iter",
                 "lr",
+                "skeleton",
             ],
         }
     }
@@ -139,6 +142,14 @@ impl Solver {
                 "late_steps" => c.late_steps = count()?,
                 "tau" => c.tau = real()? as f32,
                 "smooth" => c.smooth_frames = real()? as f32,
+                "feet" => c.foot_lock = real()? as f32,
+                "early_root" => {
+                    c.early_root_only = match count()? {
+                        0 => false,
+                        1 => true,
+                        _ => return Err("`early_root` is 0 (every column) or 1 (root columns only before the late steps)".into()),
+                    }
+                }
                 "skeleton" => {
                     c.keep_skeleton = match count()? {
                         0 => false,
@@ -183,6 +194,13 @@ impl Solver {
                 "history" => c.history = count()?,
                 "max_iter" => c.max_iter = count()?,
                 "lr" => c.lr = real()?,
+                "skeleton" => {
+                    c.keep_skeleton = match count()? {
+                        0 => false,
+                        1 => true,
+                        _ => return Err("`skeleton` is 0 (off) or 1 (keep bone lengths)".into()),
+                    }
+                }
                 _ => return Err(unknown()),
             },
         }

@@ -5,6 +5,7 @@
 use super::host::{HEAD, HostFk, HostObjective, extract_head};
 use super::*;
 use crate::features::FEATURE_DIM;
+use crate::features::layout::RIC;
 use crate::model::config::ModelConfig;
 use crate::model::generate::{GenerateRequest, generate};
 use crate::model::noise::NoiseSource;
@@ -554,10 +555,13 @@ fn host_fk_backward_matches_finite_differences() {
 #[test]
 fn fused_and_graph_guidance_agree() {
     let bundle = tiny_bundle();
+    // The graph path is OmniControl's plain update: none of the fused path's additions.
     let cfg = GuideConfig {
         steps: 10,
         k_late: 30,
         keep_skeleton: false,
+        foot_lock: 0.0,
+        early_root_only: false,
         ..GuideConfig::default()
     };
     let fused = run(
@@ -855,4 +859,153 @@ fn frame_smoothing_is_symmetric_and_off_at_zero() {
     let ones = vec![1.0; frames * width];
     let smooth = smooth_over_frames(&ones, frames, width, 1.0);
     assert!((smooth[6 * width + 4] - 1.0).abs() < 1e-5);
+}
+
+#[test]
+fn early_steps_steer_the_root_and_leave_the_pose_to_the_denoiser() {
+    let bundle = tiny_bundle();
+    // Every step early (no late steps): what the guide changes is what the early rule lets it.
+    let solve = |early_root_only, err: &dyn MotionError| {
+        let cfg = GuideConfig {
+            steps: 20,
+            late_steps: 0,
+            early_root_only,
+            ..GuideConfig::default()
+        };
+        run(
+            &bundle,
+            &request(&["a person walks"], Solver::Guide(cfg)),
+            err,
+        )
+    };
+    let plain = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Plain(SamplerKind::Ddpm(20))),
+        &wrist_up,
+    );
+    // A wrist height depends on pose columns only: root-only early steps cannot touch it.
+    let root_only = solve(true, &wrist_up);
+    assert_eq!(root_only.features, plain.features, "pose edited early");
+    let every_column = solve(false, &wrist_up);
+    assert!(
+        every_column.error[0] < plain.error[0] - 0.05,
+        "{:?} vs {:?}",
+        every_column.error,
+        plain.error
+    );
+    // Where the pelvis ends depends on the root: root-only steps still steer it there.
+    let plain_pelvis = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Plain(SamplerKind::Ddpm(20))),
+        &pelvis_at_end,
+    );
+    let steered = solve(true, &pelvis_at_end);
+    assert!(
+        steered.error[0] < 0.5 * plain_pelvis.error[0],
+        "pelvis: {} vs unguided {}",
+        steered.error[0],
+        plain_pelvis.error[0]
+    );
+}
+
+#[test]
+fn the_foot_lock_adds_its_gradient_but_not_its_value() {
+    let (_, decoder, x) = random_case(1, 1);
+    let dev = Device::flex();
+    // A zero error: all the gradient is the lock's.
+    let zero = |j: Tensor<5>| j.sum_dim(4).sum_dim(3).sum_dim(2).sum_dim(1).reshape([1]) * 0.0;
+    let mut obj = HostObjective::new(&zero, &decoder, 1, FRAMES, &dev);
+    let mut head = extract_head(&x, FEATURE_DIM);
+    // Put the toes on the floor: lower every row's heights until its lowest toe is at 1 cm
+    // (height columns are absolute, in de-normalised metres).
+    let (mean, std) = (&decoder.mean, &decoder.std);
+    for row in head.chunks_exact_mut(HEAD) {
+        let y = |row: &[f32], j: usize| {
+            let c = RIC.start + 3 * (j - 1) + 1;
+            row[c] * std[c] + mean[c]
+        };
+        let low = y(row, 10).min(y(row, 11));
+        for c in (RIC.start + 1..HEAD).step_by(3).chain([3]) {
+            row[c] -= (low - 0.01) / std[c];
+        }
+    }
+    let planted = obj.lock_feet(&head, 1.0);
+    let mut g = vec![0.0; head.len()];
+    let values = obj.eval(&head, &mut g).unwrap();
+    assert_eq!(values, vec![0.0], "the lock's value is not the program's");
+    let penalty = obj.penalty()[0];
+    if planted == 0 {
+        panic!("no planted toe pairs in the test motion");
+    }
+    assert!(penalty > 0.0);
+    // Finite differences of the penalty along the gradient.
+    let norm2: f32 = g.iter().map(|v| v * v).sum();
+    let h = 1e-3 / norm2.sqrt();
+    let moved: Vec<f32> = head.iter().zip(&g).map(|(x, g)| x - h * g).collect();
+    let mut scratch = vec![0.0; head.len()];
+    obj.eval(&moved, &mut scratch).unwrap();
+    let drop = penalty - obj.penalty()[0];
+    let predicted = h * norm2;
+    assert!(
+        (drop - predicted).abs() < 0.1 * predicted,
+        "penalty fell {drop}, the gradient predicts {predicted}"
+    );
+    obj.unlock_feet();
+    obj.eval(&head, &mut scratch).unwrap();
+    assert_eq!(obj.penalty(), &[0.0]);
+    assert!(
+        scratch.iter().all(|v| *v == 0.0),
+        "gradient without the lock"
+    );
+}
+
+#[test]
+fn lbfgs_keeps_the_skeleton_in_its_late_steps() {
+    use crate::skeleton::{BONE_LENGTHS, NUM_JOINTS, PARENTS};
+    let bundle = tiny_bundle();
+    let worst_bone = |r: &SolveResult| {
+        let mut worst = 0.0f32;
+        for f in &r.motions[0][0].frames {
+            for j in 1..NUM_JOINTS {
+                let l = (f[j] - f[PARENTS[j]]).length();
+                worst = worst.max((l - BONE_LENGTHS[j]).abs());
+            }
+        }
+        worst
+    };
+    let cfg = |keep_skeleton| LbfgsConfig {
+        steps: 30,
+        keep_skeleton,
+        ..LbfgsConfig::default()
+    };
+    let plain = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Lbfgs(cfg(false)).unguided()),
+        &wrist_up,
+    );
+    let loose = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Lbfgs(cfg(false))),
+        &wrist_up,
+    );
+    let kept = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Lbfgs(cfg(true))),
+        &wrist_up,
+    );
+    assert!(
+        worst_bone(&loose) > 0.05,
+        "the tiny model already keeps bones"
+    );
+    assert!(
+        worst_bone(&kept) < 1e-3,
+        "bones off by {}",
+        worst_bone(&kept)
+    );
+    assert!(
+        kept.error[0] < 0.5 * plain.error[0],
+        "kept {} vs unguided {}",
+        kept.error[0],
+        plain.error[0]
+    );
 }
