@@ -258,13 +258,7 @@ pub(crate) fn run(
     let mut noise = ctx.step_noise();
     let dims = ctx.dims();
     let n = schedule.len();
-    let mut objective = HostObjective::new(
-        ctx.error,
-        &ctx.decoder,
-        ctx.samples,
-        ctx.frames,
-        &ctx.device,
-    );
+    let mut objective = ctx.host_objective();
     let mut x = ctx.initial_tensor(&ctx.device);
     let mut trace = Vec::with_capacity(n);
     for i in (0..n).rev() {

@@ -13,7 +13,7 @@
 
 use super::SolveError;
 use super::adam::Adam;
-use super::host::{HostObjective, extract_head, insert_head};
+use super::host::{extract_head, insert_head};
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, check_kind, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
@@ -97,13 +97,7 @@ pub(crate) fn run(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome, SolveError> {
     let mut x = host(ctx.sample_plain(cfg.sampler, progress));
-    let mut objective = HostObjective::new(
-        ctx.error,
-        &ctx.decoder,
-        ctx.samples,
-        ctx.frames,
-        &ctx.device,
-    );
+    let mut objective = ctx.host_objective();
     let mut adam = Adam::new(x.len(), cfg.lr);
     let mut grad = vec![0.0; x.len()];
     let mut trace = Vec::with_capacity(cfg.iterations);

@@ -18,7 +18,7 @@
 //! without the projection the late steps meet a contact by stretching an arm.
 
 use super::SolveError;
-use super::host::{HostObjective, check_shape, extract_head, insert_head};
+use super::host::{check_shape, extract_head, insert_head};
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
@@ -104,13 +104,7 @@ pub(crate) fn run(
         .with_history_size(cfg.history)
         .with_max_iter(cfg.max_iter)
         .with_line_search_fn(LineSearchFn::StrongWolfe);
-    let mut objective = HostObjective::new(
-        ctx.error,
-        &ctx.decoder,
-        ctx.samples,
-        ctx.frames,
-        &ctx.device,
-    );
+    let mut objective = ctx.host_objective();
     let mut x = ctx.initial_tensor(&ctx.device);
     let mut trace = Vec::with_capacity(n);
     for i in (0..n).rev() {

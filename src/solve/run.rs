@@ -3,7 +3,7 @@
 //! motions, features and final errors.
 
 use super::decode::Decoder;
-use super::host::check_shape;
+use super::host::{HostObjective, check_shape};
 use super::place::{DEFAULT_SPACING, Placement};
 use super::request::{Phase, Prior, Progress, SolveRequest, SolveResult, Solver};
 use super::{MotionError, SolveError, guide, ik, latent, lbfgs};
@@ -50,6 +50,18 @@ pub(crate) struct Outcome {
 }
 
 impl Ctx<'_> {
+    /// The fused host evaluation of this request's error (the inner loops of guide, IK
+    /// and lbfgs's late steps).
+    pub fn host_objective(&self) -> HostObjective<'_> {
+        HostObjective::new(
+            self.error,
+            &self.decoder,
+            self.samples,
+            self.frames,
+            &self.device,
+        )
+    }
+
     /// Motions in the batch (B·P).
     pub fn motions(&self) -> usize {
         self.samples * self.people
