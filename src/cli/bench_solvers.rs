@@ -61,11 +61,11 @@ fn timed(
         .expect("template"),
     );
     let req = SolveRequest::new(prompts.to_vec(), program.length(), seed, solver);
-    let error = |j| program.evaluate(j).total;
+    let error: &dyn mprog::solve::MotionError = program;
     let out = solve(
         &Prior::from_bundle(bundle),
         &req,
-        &error,
+        error,
         device,
         |p: Progress| {
             bar.set_length(p.total as u64);
@@ -117,6 +117,7 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
                 keep_skeleton: false,
                 foot_lock: 0.0,
                 early_root_only: false,
+                split_terms: false,
                 ..guide.clone()
             }),
             "guide (burn autodiff tape, skeleton=0)",

@@ -109,11 +109,11 @@ fn solve_with_bar(
         ))
         .expect("template"),
     );
-    let error = |j: Tensor<5>| program.evaluate(j).total;
+    let error: &dyn mprog::solve::MotionError = program;
     let out = solve(
         &Prior::from_bundle(bundle),
         req,
-        &error,
+        error,
         device,
         |p: Progress| {
             bar.set_length(p.total as u64);

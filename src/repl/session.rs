@@ -307,10 +307,10 @@ impl Session {
         };
         let req = SolveRequest::new(prompts, program.length(), seed, solver.clone());
         let device = self.device.clone();
-        let error = |j: burn::tensor::Tensor<5>| program.evaluate(j).total;
+        let error: &dyn crate::solve::MotionError = &program;
         let result = match self.bundle() {
             Err(e) => return Reply::error(e),
-            Ok(bundle) => solve(&Prior::from_bundle(bundle), &req, &error, &device, |_| {}),
+            Ok(bundle) => solve(&Prior::from_bundle(bundle), &req, error, &device, |_| {}),
         };
         match result {
             Err(e) => Reply::error(format!("{} failed: {e}", solver.name())),

@@ -41,6 +41,18 @@
 //! that are on the floor, so a constraint met by moving the root moves the legs with it.
 //! On the walking programs it halves the skating of the result at the same program error.
 //!
+//! Each statement of a program gets its own Polyak step (mprog's addition, on by default:
+//! [`GuideConfig::split_terms`]) and the iteration steps along their sum: each one removes
+//! its share of its own linearised error, whatever the others' gradients. With one step
+//! for the whole error, a stiff statement sets the pace: `faceToFace` at two frames has a
+//! large gradient (a kink at zero, hip vectors 0.2 m long) and a small value, so the step
+//! sized on the sum hardly moved the handshake's contact (0.29 m off after the last step,
+//! the facing term bouncing across its kink); stepped apart, both are met (0.01 m). The
+//! foot lock's penalty is shared out among the statements in proportion to their errors
+//! ([`TermGradients::share_penalty`](super::host::TermGradients::share_penalty)): as a
+//! term with a step of its own it held the feet so firmly that the hands could not meet.
+//! A single-statement program steps exactly as before.
+//!
 //! The denoiser is not in the inner loop: only FK, the error and its gradient are, through
 //! the fused host path ([`super::host`]) by default.
 //!
@@ -79,7 +91,7 @@
 //! hinges). With a single keyframe distance it is OmniControl's step with an adaptive τ.
 
 use super::SolveError;
-use super::host::{HEAD, HostObjective, check_shape, extract_head, insert_head};
+use super::host::{HEAD, HostObjective, TermGradients, check_shape, extract_head, insert_head};
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
@@ -153,6 +165,10 @@ pub struct GuideConfig {
     /// velocity, height): the path is steered while the denoiser keeps the pose its own
     /// (see the module notes). Needs the fused path.
     pub early_root_only: bool,
+    /// Size the Polyak step of each term of the error (each statement, and the foot lock)
+    /// on its own and step along the sum (see the module notes); `false` sizes one step
+    /// for the whole error. Needs the fused path.
+    pub split_terms: bool,
 }
 
 impl Default for GuideConfig {
@@ -172,6 +188,7 @@ impl Default for GuideConfig {
             smooth_frames: 4.0,
             foot_lock: 1.0,
             early_root_only: true,
+            split_terms: true,
         }
     }
 }
@@ -208,6 +225,11 @@ impl GuideConfig {
         if self.early_root_only && !self.fused {
             return Err(SolveError::Invalid(
                 "guide: early root-only steps need the fused inner loop (set fused or early_root to 0)".into(),
+            ));
+        }
+        if self.split_terms && !self.fused {
+            return Err(SolveError::Invalid(
+                "guide: per-term steps need the fused inner loop (set fused or split to 0)".into(),
             ));
         }
         if self.keep_skeleton && !self.fused {
@@ -342,6 +364,44 @@ fn guide_fused(
     if foot_lock > 0.0 {
         objective.lock_feet(&head, foot_lock);
     }
+    let moving = if cfg.early_root_only && i >= cfg.late_steps {
+        ROOT_COLUMNS
+    } else {
+        HEAD
+    };
+    if cfg.split_terms && cfg.step_rule == StepRule::Polyak {
+        let mut terms = TermGradients::default();
+        let mut combined = vec![0.0; head.len()];
+        for it in 0..k {
+            objective.eval_terms(&head, &mut terms)?;
+            values.clone_from(&terms.total);
+            ensure_finite(&values, "guide", "error", || at(it))?;
+            terms.share_penalty();
+            combined.fill(0.0);
+            for (term, g) in terms.values.iter().zip(terms.grads.iter_mut()) {
+                ensure_finite(term, "guide", "error", || at(it))?;
+                ensure_finite(g, "guide", "gradient", || at(it))?;
+                let mut dir = smooth_over_frames(g, ctx.frames, HEAD, sigma);
+                if cfg.freeze_first_frame {
+                    for m in 0..ctx.motions() {
+                        let f0 = m * ctx.frames * HEAD;
+                        g[f0..f0 + HEAD].fill(0.0);
+                        dir[f0..f0 + HEAD].fill(0.0);
+                    }
+                }
+                add_polyak_step(&mut combined, g, &dir, term, step);
+            }
+            let per = term_block(&head, &values);
+            apply_capped(&mut head, &combined, per, (HEAD, moving));
+        }
+        objective.unlock_feet();
+        if skeleton {
+            objective.apply_projection(&mut head);
+            objective.stop_projecting();
+        }
+        insert_head(full, FEATURE_DIM, &head);
+        return Ok(values);
+    }
     let mut total = Vec::new();
     for it in 0..k {
         values = objective.eval(&head, &mut grad)?;
@@ -362,11 +422,6 @@ fn guide_fused(
         // Early root-only steps take the step the full gradient calls for, on the root
         // columns alone: restricting the direction must not enlarge the step (a pose error
         // with a small root gradient would otherwise push the root height by metres).
-        let moving = if cfg.early_root_only && i >= cfg.late_steps {
-            ROOT_COLUMNS
-        } else {
-            HEAD
-        };
         apply_step(cfg, &mut head, &grad, &dir, &total, step, (HEAD, moving));
     }
     objective.unlock_feet();
@@ -484,6 +539,62 @@ fn apply_step(
                         *x -= s * d;
                     }
                 }
+            }
+        }
+    }
+}
+
+/// Adds to `combined` the Polyak step of one term: per sample block, direction `d` (the
+/// term's gradient `g`, smoothed or not) times `min(1, step)·e/⟨g, d⟩`, the step that
+/// removes that fraction of the term's linearised error. Blocks whose term is ≤ 0 or flat
+/// add nothing.
+fn add_polyak_step(combined: &mut [f32], g: &[f32], d: &[f32], values: &[f32], step: f32) {
+    let per = combined.len() / values.len();
+    let fraction = step.min(1.0) as f64;
+    let blocks = combined
+        .chunks_exact_mut(per)
+        .zip(g.chunks_exact(per))
+        .zip(d.chunks_exact(per));
+    for (((cb, gb), db), &e) in blocks.zip(values) {
+        let slope: f64 = gb
+            .iter()
+            .zip(db)
+            .map(|(g, d)| (*g as f64) * (*d as f64))
+            .sum();
+        if slope <= 1e-20 || e <= 0.0 {
+            continue;
+        }
+        let s = (fraction * e as f64 / slope) as f32;
+        for (c, d) in cb.iter_mut().zip(db) {
+            *c += s * d;
+        }
+    }
+}
+
+/// Samples' block length in `x` (one block per error value).
+fn term_block(x: &[f32], values: &[f32]) -> usize {
+    x.len() / values.len().max(1)
+}
+
+/// `x ← x − c` on the first `moving` of every `width` columns, per sample block of `per`
+/// values scaled down so that no value moves more than [`MAX_POLYAK_DELTA`]. The terms'
+/// steps are sized on their whole gradients: restricting the columns (early root-only
+/// steps) must not enlarge them.
+fn apply_capped(x: &mut [f32], c: &[f32], per: usize, (width, moving): (usize, usize)) {
+    let moves = |k: usize| k % width < moving;
+    for (xb, cb) in x.chunks_exact_mut(per).zip(c.chunks_exact(per)) {
+        let c_max = cb
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| moves(*k))
+            .fold(0.0f32, |m, (_, v)| m.max(v.abs()));
+        if c_max == 0.0 {
+            continue;
+        }
+        let scale = (MAX_POLYAK_DELTA / c_max).min(1.0);
+        for (k, (x, c)) in xb.iter_mut().zip(cb).enumerate() {
+            if moves(k) {
+                *x -= scale * c;
             }
         }
     }

@@ -75,6 +75,24 @@ use burn::tensor::Tensor;
 pub trait MotionError {
     /// `[batch]` error of each sample.
     fn error(&self, joints: Tensor<5>) -> Tensor<1>;
+
+    /// `[batch, terms]`: the error split into terms that sum to [`Self::error`] (a
+    /// program's statements). The guide sizes a step for each term on its own, so a stiff
+    /// term cannot set the pace of the others; one term by default.
+    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
+        self.error(joints).unsqueeze_dim(1)
+    }
+}
+
+/// A program's error is the sum of its statements' errors; its terms are the statements.
+impl MotionError for crate::lang::Program {
+    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
+        self.evaluate(joints).total
+    }
+
+    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
+        self.evaluate(joints).per_statement
+    }
 }
 
 impl<F: Fn(Tensor<5>) -> Tensor<1>> MotionError for F {

@@ -94,6 +94,7 @@ impl Solver {
                 "smooth",
                 "feet",
                 "early_root",
+                "split",
             ],
             Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax"],
             Solver::Ik(_) => &["ddim_steps", "iterations", "lr", "smoothness"],
@@ -148,6 +149,13 @@ impl Solver {
                         0 => false,
                         1 => true,
                         _ => return Err("`early_root` is 0 (every column) or 1 (root columns only before the late steps)".into()),
+                    }
+                }
+                "split" => {
+                    c.split_terms = match count()? {
+                        0 => false,
+                        1 => true,
+                        _ => return Err("`split` is 0 (one step for the whole error) or 1 (a step per statement)".into()),
                     }
                 }
                 "skeleton" => {

@@ -562,6 +562,7 @@ fn fused_and_graph_guidance_agree() {
         keep_skeleton: false,
         foot_lock: 0.0,
         early_root_only: false,
+        split_terms: false,
         ..GuideConfig::default()
     };
     let fused = run(
@@ -965,4 +966,129 @@ fn lbfgs_keeps_the_skeleton_in_its_late_steps() {
             ..LbfgsConfig::default()
         })
     });
+}
+
+/// Two terms: the pelvis target at the end and the wrist above 1.6 m.
+struct TwoTerms;
+
+impl MotionError for TwoTerms {
+    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
+        pelvis_at_end(joints.clone()) + wrist_up(joints)
+    }
+
+    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
+        Tensor::stack(vec![pelvis_at_end(joints.clone()), wrist_up(joints)], 1)
+    }
+}
+
+#[test]
+fn term_gradients_add_up_to_the_whole_gradient() {
+    let (_, decoder, x) = random_case(1, 2);
+    let dev = Device::flex();
+    let mut obj = HostObjective::new(&TwoTerms, &decoder, 2, FRAMES, &dev);
+    let head = extract_head(&x, FEATURE_DIM);
+    let mut whole = vec![0.0; head.len()];
+    let values = obj.eval(&head, &mut whole).unwrap();
+    let mut terms = super::host::TermGradients::default();
+    obj.eval_terms(&head, &mut terms).unwrap();
+    assert_eq!(terms.statements, 2);
+    assert_eq!(terms.values.len(), 2);
+    for (b, v) in values.iter().enumerate() {
+        let sum = terms.values[0][b] + terms.values[1][b];
+        assert!((terms.total[b] - v).abs() < 1e-5 && (sum - v).abs() < 1e-5);
+    }
+    let biggest = whole.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    assert!(biggest > 0.0);
+    for (k, w) in whole.iter().enumerate() {
+        let sum = terms.grads[0][k] + terms.grads[1][k];
+        assert!(
+            (sum - w).abs() <= 1e-4 * biggest,
+            "column {k}: {sum} vs {w}"
+        );
+    }
+    // The terms differ: the wrist's gradient has no root velocity, the pelvis target's has.
+    assert!(terms.grads[0] != terms.grads[1]);
+}
+
+#[test]
+fn a_shared_foot_penalty_keeps_the_sums() {
+    let mut terms = super::host::TermGradients {
+        total: vec![3.0, 0.0],
+        values: vec![vec![1.0, 0.0], vec![2.0, 0.0], vec![0.3, 0.5]],
+        grads: vec![
+            vec![1.0, 0.0, 0.0, 0.0],
+            vec![0.0, 1.0, 0.0, 0.0],
+            vec![0.6, 0.6, 0.4, 0.4],
+        ],
+        statements: 2,
+    };
+    terms.share_penalty();
+    // Sample 0: the penalty goes 1/3 to the first term, 2/3 to the second.
+    assert!((terms.values[0][0] - 1.1).abs() < 1e-6 && (terms.values[1][0] - 2.2).abs() < 1e-6);
+    assert!((terms.grads[0][0] - 1.2).abs() < 1e-6 && (terms.grads[0][1] - 0.2).abs() < 1e-6);
+    assert!((terms.grads[1][0] - 0.4).abs() < 1e-6 && (terms.grads[1][1] - 1.4).abs() < 1e-6);
+    // Sample 1 has no error: its penalty stays a term of its own.
+    assert_eq!(terms.values.len(), 3);
+    assert_eq!(terms.values[2], vec![0.0, 0.5]);
+    assert_eq!(terms.grads[2], vec![0.0, 0.0, 0.4, 0.4]);
+}
+
+/// A stiff term (the wrist's sideways position at frame 3, weighted 50, a kink at its
+/// target) and a soft one (the pelvis target at the end).
+struct StiffAndSoft;
+
+impl StiffAndSoft {
+    fn stiff(j: Tensor<5>) -> Tensor<1> {
+        let [b, _, _, _, _] = j.dims();
+        (joint(j, 21).narrow(2, 3, 1).narrow(4, 0, 1) - 0.3)
+            .abs()
+            .reshape([b])
+            * 50.0
+    }
+}
+
+impl MotionError for StiffAndSoft {
+    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
+        Self::stiff(joints.clone()) + pelvis_at_end(joints)
+    }
+
+    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
+        Tensor::stack(vec![Self::stiff(joints.clone()), pelvis_at_end(joints)], 1)
+    }
+}
+
+#[test]
+fn a_stiff_statement_does_not_set_the_pace_of_the_others() {
+    let bundle = tiny_bundle();
+    let solve = |split_terms| {
+        let cfg = GuideConfig {
+            steps: 20,
+            k_late: 30,
+            late_steps: 3,
+            split_terms,
+            ..GuideConfig::default()
+        };
+        run(
+            &bundle,
+            &request(&["a person walks"], Solver::Guide(cfg)),
+            &StiffAndSoft,
+        )
+    };
+    let soft = |r: &SolveResult| {
+        let p = r.motions[0][0].frames[FRAMES - 1][0];
+        (p - glam::Vec3::new(0.0, 0.9, 1.5)).length()
+    };
+    let (split, whole) = (solve(true), solve(false));
+    assert!(
+        soft(&split) < 0.5 * soft(&whole),
+        "pelvis target: {} split, {} one step",
+        soft(&split),
+        soft(&whole)
+    );
+    assert!(
+        split.error[0] < whole.error[0],
+        "{:?} vs {:?}",
+        split.error,
+        whole.error
+    );
 }

@@ -87,8 +87,8 @@ pub fn run_task(
         samples: task.samples,
         ..SolveRequest::new(task.prompts.clone(), task.frames, seed, solver.clone())
     };
-    let error = |j: Tensor<5>| task.error(j);
-    let result = match solve(prior, &req, &error, device, on_progress) {
+    let error: &dyn crate::solve::MotionError = task;
+    let result = match solve(prior, &req, error, device, on_progress) {
         Ok(r) => r,
         Err(e) => {
             row.failure = Some(e.to_string());

@@ -4,7 +4,7 @@ use super::keyframe::{CONTROLLED, Density, KeyframeGoal};
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
 use crate::lang::Program;
 use crate::model::sampler::SamplerKind;
-use crate::solve::{GuideConfig, IkConfig, LatentConfig, LbfgsConfig, Solver};
+use crate::solve::{GuideConfig, IkConfig, LatentConfig, LbfgsConfig, MotionError, Solver};
 use burn::prelude::*;
 use std::path::Path;
 
@@ -60,6 +60,19 @@ impl Task {
         match &self.goal {
             Goal::Program(p) => p.evaluate(joints).total,
             Goal::Keyframes(k) => k.error(joints),
+        }
+    }
+}
+
+impl MotionError for Task {
+    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
+        Task::error(self, joints)
+    }
+
+    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
+        match &self.goal {
+            Goal::Program(p) => p.evaluate(joints).per_statement,
+            Goal::Keyframes(k) => k.error(joints).unsqueeze_dim(1),
         }
     }
 }
