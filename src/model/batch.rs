@@ -4,6 +4,7 @@
 
 use super::config::TrainConfig;
 use super::schedule::DIFFUSION_STEPS;
+use super::text::{is_function_word, words_of};
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -32,6 +33,24 @@ pub fn step_rng(seed: u64, step: usize) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ step as u64)
 }
 
+/// `caption` with each word dropped with probability `p`; the words the text encoder
+/// reads are never all dropped (when every one was, the caption comes back whole).
+pub fn drop_words(caption: &str, p: f64, rng: &mut impl Rng) -> String {
+    if p <= 0.0 {
+        return caption.to_string();
+    }
+    let kept: Vec<&str> = caption
+        .split_whitespace()
+        .filter(|_| rng.random::<f64>() >= p)
+        .collect();
+    let text = kept.join(" ");
+    if words_of(&text).iter().any(|w| !is_function_word(w)) {
+        text
+    } else {
+        caption.to_string()
+    }
+}
+
 /// Draws the batch of `step`.
 pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: usize) -> HostBatch {
     let mut rng = step_rng(cfg.seed, step);
@@ -57,7 +76,8 @@ pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: us
             }
             padding[i * frames + k] = false;
         }
-        captions.push(clip.captions[rng.random_range(0..clip.captions.len())].clone());
+        let caption = &clip.captions[rng.random_range(0..clip.captions.len())];
+        captions.push(drop_words(caption, cfg.word_drop, &mut rng));
     }
     let timesteps = (0..b)
         .map(|_| rng.random_range(0..DIFFUSION_STEPS))
@@ -79,5 +99,37 @@ pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: us
         timesteps,
         keep_text,
         noise_seed: rng.random(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn word_dropout_keeps_a_content_word_and_is_seeded() {
+        let caption = "a person walks forward";
+        let mut rng = step_rng(1, 0);
+        let mut seen = std::collections::HashSet::new();
+        for _ in 0..400 {
+            let short = drop_words(caption, 0.5, &mut rng);
+            assert!(
+                words_of(&short).iter().any(|w| !is_function_word(w)),
+                "{short:?} has no content word"
+            );
+            assert!(short.split_whitespace().all(|w| caption.contains(w)));
+            seen.insert(short);
+        }
+        // Subsets appear: "person walks", "a walks", "walks forward", ... and the whole.
+        assert!(
+            seen.contains("person walks") && seen.contains(caption),
+            "{seen:?}"
+        );
+        assert!(seen.len() > 8, "{seen:?}");
+        let again = |seed| drop_words(caption, 0.5, &mut step_rng(seed, 3));
+        assert_eq!(again(7), again(7));
+        assert_eq!(drop_words(caption, 0.0, &mut rng), caption);
+        // Only function words left: the caption comes back whole.
+        assert_eq!(drop_words("a the", 0.9, &mut rng), "a the");
     }
 }

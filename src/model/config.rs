@@ -80,6 +80,11 @@ pub struct TrainConfig {
     /// Weight of the velocity loss on the stored joint positions (0 disables).
     #[serde(default)]
     pub velocity_loss: f64,
+    /// Probability of dropping each word of a training caption (at least one content word
+    /// stays): captions always say "walks forward" or "walks straight ahead", so without it
+    /// "a person walks" was a word set the bag-of-words encoder never saw, and stood still.
+    #[serde(default)]
+    pub word_drop: f64,
     /// Seed of the data order and noise.
     pub seed: u64,
 }
@@ -100,6 +105,7 @@ impl Default for TrainConfig {
             checkpoint_every: 200,
             foot_loss: 0.0,
             velocity_loss: 0.0,
+            word_drop: 0.0,
             seed: 1,
         }
     }
@@ -172,6 +178,7 @@ impl TrainConfig {
             }
         }
         fraction("cond_drop", self.cond_drop, false)?;
+        fraction("word_drop", self.word_drop, false)?;
         fraction("ema_decay", self.ema_decay, true)
     }
 }

@@ -37,6 +37,11 @@ const STOP_WORDS: &[&str] = &[
     "his", "her", "with",
 ];
 
+/// Whether `word` (lower case) is a function word the vocabulary leaves out.
+pub fn is_function_word(word: &str) -> bool {
+    STOP_WORDS.contains(&word)
+}
+
 impl Vocabulary {
     /// Builds the vocabulary from every caption (sorted, so ids are deterministic).
     pub fn from_captions<'a>(

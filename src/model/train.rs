@@ -522,6 +522,7 @@ impl TrainRun<'_> {
         }
         let mut cfg = self.config.clone();
         cfg.cond_drop = 0.0;
+        cfg.word_drop = 0.0;
         let mut total = 0.0;
         let rounds = 4;
         for r in 0..rounds {

@@ -41,9 +41,13 @@
 //! that are on the floor, so a constraint met by moving the root moves the legs with it.
 //! On the walking programs it halves the skating of the result at the same program error.
 //!
-//! Each statement of a program gets its own Polyak step (mprog's addition, on by default:
-//! [`GuideConfig::split_terms`]) and the iteration steps along their sum: each one removes
-//! its share of its own linearised error, whatever the others' gradients. With one step
+//! In the last T_s steps each statement of a program gets its own Polyak step (mprog's
+//! addition, on by default: [`GuideConfig::split_terms`]) and the iteration steps along
+//! their sum: each one removes its share of its own linearised error, whatever the others'
+//! gradients. Earlier steps, which move only the path, keep one step for the whole error:
+//! split there, statements that conflict over the path pulled it each their own way
+//! (HSI-4 met "duck under the barrier" by stopping before it, 0.76 m short of its end
+//! target). With one step
 //! for the whole error, a stiff statement sets the pace: `faceToFace` at two frames has a
 //! large gradient (a kink at zero, hip vectors 0.2 m long) and a small value, so the step
 //! sized on the sum hardly moved the handshake's contact (0.29 m off after the last step,
@@ -165,9 +169,9 @@ pub struct GuideConfig {
     /// velocity, height): the path is steered while the denoiser keeps the pose its own
     /// (see the module notes). Needs the fused path.
     pub early_root_only: bool,
-    /// Size the Polyak step of each term of the error (each statement, and the foot lock)
-    /// on its own and step along the sum (see the module notes); `false` sizes one step
-    /// for the whole error. Needs the fused path.
+    /// In the last `late_steps` steps, size the Polyak step of each term of the error (each
+    /// statement) on its own and step along the sum (see the module notes); `false` sizes
+    /// one step for the whole error. Needs the fused path.
     pub split_terms: bool,
 }
 
@@ -369,7 +373,10 @@ fn guide_fused(
     } else {
         HEAD
     };
-    if cfg.split_terms && cfg.step_rule == StepRule::Polyak {
+    // Split in the late steps only: early, where only the path moves, statements that
+    // conflict over the path each pulled it their own way (HSI-4's "duck under the barrier"
+    // met by stopping short of it, against "end past it": 0.76 m short).
+    if cfg.split_terms && cfg.step_rule == StepRule::Polyak && i < cfg.late_steps {
         let mut terms = TermGradients::default();
         let mut combined = vec![0.0; head.len()];
         for it in 0..k {

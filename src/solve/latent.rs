@@ -16,6 +16,14 @@
 //! a horizontal rigid motion (planes, lines, point pairs), done in one loop instead of
 //! relaxation rounds.
 //!
+//! Skeleton (mprog's addition, on by default: [`LatentConfig::keep_skeleton`]): the error
+//! is that of `P(x̂)`, the chain's output with its bone lengths restored and its planted
+//! feet kept on the floor ([`super::bones`]), and `P(x̂)` is what is returned. The chain's
+//! own output keeps no skeleton when z is pushed to meet a program: limbs stretched by
+//! 6–18 cm in the cookbook's `latent` runs. The gradient goes through `P` on the fused
+//! host path ([`super::host`]) and enters the chain as `⟨x̂, ∂E/∂x̂⟩`. Not with relaxation,
+//! whose rigid move is differentiated through the burn decoder.
+//!
 //! Memory: with [`LatentConfig::checkpoint`] off (the default, as PMG), the graph of the
 //! whole chain (steps × 2 CFG passes) is kept for one backward (measured: 1519 MiB peak RSS
 //! at 100 steps, 120 frames, one motion; it grows with B·P). With it on, the forward runs
@@ -27,10 +35,12 @@
 
 use super::adam::Adam;
 use super::decode::RigidTensors;
+use super::host::{extract_head, insert_head};
 use super::place::Placement;
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
 use super::{SolveError, host::check_shape};
+use crate::features::FEATURE_DIM;
 use crate::model::sampler::{Condition, ddim_step, guided_x0};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::model::{Denoiser, Mdm};
@@ -60,6 +70,9 @@ pub struct LatentConfig {
     pub relax_lr: f64,
     /// Re-run each DDIM step during the backward instead of keeping the whole graph.
     pub checkpoint: bool,
+    /// Measure and return the chain's output through the skeleton projection (see the
+    /// module notes); ignored with relaxation.
+    pub keep_skeleton: bool,
 }
 
 impl Default for LatentConfig {
@@ -71,6 +84,7 @@ impl Default for LatentConfig {
             relax: Relax::None,
             relax_lr: 0.02,
             checkpoint: false,
+            keep_skeleton: true,
         }
     }
 }
@@ -164,6 +178,8 @@ pub(crate) fn run(
     let mut last = Vec::new();
     let plain_model = ctx.denoiser();
     let plain_cond = ctx.condition(&ctx.device);
+    let skeleton = cfg.keep_skeleton && !relax;
+    let mut objective = ctx.host_objective();
     for it in 0..cfg.iterations {
         let at = || format!("iteration {}/{}", it + 1, cfg.iterations);
         let zt = Tensor::<3>::from_data(TensorData::new(z.clone(), dims), &ad).require_grad();
@@ -198,15 +214,34 @@ pub(crate) fn run(
                 z: part(2),
             }
         });
-        let e = ctx.error.error(ctx.decoder.joints(x.clone(), rt.as_ref()));
-        check_shape(&e, ctx.samples)?;
-        let values = e
-            .clone()
-            .into_data()
-            .try_to_vec::<f32>()
-            .expect("f32 error");
-        ensure_finite(&values, "latent", "error", at)?;
-        last = host(x.clone().detach());
+        let (e, values) = if skeleton {
+            // E(P(x̂)) on the host; the chain sees it as ⟨x̂, ∂E/∂x̂⟩.
+            let mut full = host(x.clone().detach());
+            let mut head = extract_head(&full, FEATURE_DIM);
+            objective.project_skeleton(&head);
+            let mut g_head = vec![0.0; head.len()];
+            let values = objective.eval(&head, &mut g_head)?;
+            ensure_finite(&values, "latent", "error", at)?;
+            objective.apply_projection(&mut head);
+            objective.stop_projecting();
+            insert_head(&mut full, FEATURE_DIM, &head);
+            last = full;
+            let mut g_full = vec![0.0; last.len()];
+            insert_head(&mut g_full, FEATURE_DIM, &g_head);
+            let g = Tensor::<3>::from_data(TensorData::new(g_full, dims), &ad);
+            ((x.clone() * g).sum().reshape([1]), values)
+        } else {
+            let e = ctx.error.error(ctx.decoder.joints(x.clone(), rt.as_ref()));
+            check_shape(&e, ctx.samples)?;
+            let values = e
+                .clone()
+                .into_data()
+                .try_to_vec::<f32>()
+                .expect("f32 error");
+            ensure_finite(&values, "latent", "error", at)?;
+            last = host(x.clone().detach());
+            (e, values)
+        };
         progress(Progress {
             phase: Phase::Optimising,
             done: it + 1,

@@ -96,7 +96,7 @@ impl Solver {
                 "early_root",
                 "split",
             ],
-            Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax"],
+            Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax", "skeleton"],
             Solver::Ik(_) => &["ddim_steps", "iterations", "lr", "smoothness"],
             Solver::Lbfgs(_) => &[
                 "steps",
@@ -183,6 +183,13 @@ impl Solver {
                         0 => super::latent::Relax::None,
                         1 => super::latent::Relax::RigidXz,
                         _ => return Err("`relax` is 0 (off) or 1 (rigid XZ)".into()),
+                    }
+                }
+                "skeleton" => {
+                    c.keep_skeleton = match count()? {
+                        0 => false,
+                        1 => true,
+                        _ => return Err("`skeleton` is 0 (off) or 1 (keep bone lengths)".into()),
                     }
                 }
                 _ => return Err(unknown()),

@@ -239,9 +239,14 @@ fn latent_trace_starts_at_the_unguided_ddim_sample() {
     let bundle = tiny_bundle();
     let req = request(&["a person walks"], Solver::Plain(SamplerKind::Ddim(8)));
     let plain = run(&bundle, &req, &pelvis_at_end);
+    // Without the skeleton projection, which would measure a projected sample.
+    let cfg = LatentConfig {
+        keep_skeleton: false,
+        ..small_latent()
+    };
     let latent = run(
         &bundle,
-        &request(&["a person walks"], Solver::Latent(small_latent())),
+        &request(&["a person walks"], Solver::Latent(cfg)),
         &pelvis_at_end,
     );
     let first = latent.trace[0][0];
@@ -955,6 +960,16 @@ fn the_foot_lock_adds_its_gradient_but_not_its_value() {
         scratch.iter().all(|v| *v == 0.0),
         "gradient without the lock"
     );
+}
+
+#[test]
+fn latent_keeps_the_skeleton() {
+    check_keeps_the_skeleton(|keep_skeleton| {
+        Solver::Latent(LatentConfig {
+            keep_skeleton,
+            ..small_latent()
+        })
+    });
 }
 
 #[test]
