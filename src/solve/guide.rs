@@ -376,10 +376,12 @@ fn guide_fused(
     // Split in the late steps only: early, where only the path moves, statements that
     // conflict over the path each pulled it their own way (HSI-4's "duck under the barrier"
     // met by stopping short of it, against "end past it": 0.76 m short).
-    if cfg.split_terms && cfg.step_rule == StepRule::Polyak && i < cfg.late_steps {
-        let mut terms = TermGradients::default();
-        let mut combined = vec![0.0; head.len()];
-        for it in 0..k {
+    let split = cfg.split_terms && cfg.step_rule == StepRule::Polyak && i < cfg.late_steps;
+    let mut terms = TermGradients::default();
+    let mut combined = vec![0.0; head.len()];
+    let mut total = Vec::new();
+    for it in 0..k {
+        if split {
             objective.eval_terms(&head, &mut terms)?;
             values.clone_from(&terms.total);
             ensure_finite(&values, "guide", "error", || at(it))?;
@@ -388,29 +390,13 @@ fn guide_fused(
             for (term, g) in terms.values.iter().zip(terms.grads.iter_mut()) {
                 ensure_finite(term, "guide", "error", || at(it))?;
                 ensure_finite(g, "guide", "gradient", || at(it))?;
-                let mut dir = smooth_over_frames(g, ctx.frames, HEAD, sigma);
-                if cfg.freeze_first_frame {
-                    for m in 0..ctx.motions() {
-                        let f0 = m * ctx.frames * HEAD;
-                        g[f0..f0 + HEAD].fill(0.0);
-                        dir[f0..f0 + HEAD].fill(0.0);
-                    }
-                }
+                let dir = step_direction(ctx, cfg, g, HEAD, sigma);
                 add_polyak_step(&mut combined, g, &dir, term, step);
             }
             let per = term_block(&head, &values);
             apply_capped(&mut head, &combined, per, (HEAD, moving));
+            continue;
         }
-        objective.unlock_feet();
-        if skeleton {
-            objective.apply_projection(&mut head);
-            objective.stop_projecting();
-        }
-        insert_head(full, FEATURE_DIM, &head);
-        return Ok(values);
-    }
-    let mut total = Vec::new();
-    for it in 0..k {
         values = objective.eval(&head, &mut grad)?;
         // The step removes a fraction of program error + foot penalty, whose gradient
         // `grad` is; the program's own error is what gets reported.
@@ -418,14 +404,7 @@ fn guide_fused(
         total.extend(values.iter().zip(objective.penalty()).map(|(e, p)| e + p));
         ensure_finite(&values, "guide", "error", || at(it))?;
         ensure_finite(&grad, "guide", "gradient", || at(it))?;
-        let mut dir = smooth_over_frames(&grad, ctx.frames, HEAD, sigma);
-        if cfg.freeze_first_frame {
-            for m in 0..ctx.motions() {
-                let f0 = m * ctx.frames * HEAD;
-                grad[f0..f0 + HEAD].fill(0.0);
-                dir[f0..f0 + HEAD].fill(0.0);
-            }
-        }
+        let dir = step_direction(ctx, cfg, &mut grad, HEAD, sigma);
         // Early root-only steps take the step the full gradient calls for, on the root
         // columns alone: restricting the direction must not enlarge the step (a pose error
         // with a small root gradient would otherwise push the root height by metres).
@@ -439,6 +418,26 @@ fn guide_fused(
     }
     insert_head(full, FEATURE_DIM, &head);
     Ok(values)
+}
+
+/// The step direction of gradient `g` (`[M, N, width]`): `g` smoothed over frames by
+/// σ = `sigma`; with a frozen first frame, frame 0 of both `g` and the direction zeroed.
+fn step_direction(
+    ctx: &Ctx,
+    cfg: &GuideConfig,
+    g: &mut [f32],
+    width: usize,
+    sigma: f32,
+) -> Vec<f32> {
+    let mut dir = smooth_over_frames(g, ctx.frames, width, sigma);
+    if cfg.freeze_first_frame {
+        for m in 0..ctx.motions() {
+            let f0 = m * ctx.frames * width;
+            g[f0..f0 + width].fill(0.0);
+            dir[f0..f0 + width].fill(0.0);
+        }
+    }
+    dir
 }
 
 /// The same K steps through the burn graph (decoder + error, autodiff).
@@ -472,14 +471,7 @@ fn guide_graph(
         }
         .unwrap_or_else(|| vec![0.0; full.len()]);
         ensure_finite(&g, "guide", "gradient", || at(it))?;
-        let mut dir = smooth_over_frames(&g, ctx.frames, FEATURE_DIM, sigma);
-        if cfg.freeze_first_frame {
-            for m in 0..ctx.motions() {
-                let f0 = m * ctx.frames * FEATURE_DIM;
-                g[f0..f0 + FEATURE_DIM].fill(0.0);
-                dir[f0..f0 + FEATURE_DIM].fill(0.0);
-            }
-        }
+        let dir = step_direction(ctx, cfg, &mut g, FEATURE_DIM, sigma);
         apply_step(
             cfg,
             full,
@@ -517,36 +509,9 @@ fn apply_step(
             }
         }
         StepRule::Polyak => {
-            let per = x.len() / values.len();
-            let fraction = step.min(1.0) as f64;
-            let blocks = x
-                .chunks_exact_mut(per)
-                .zip(g.chunks_exact(per))
-                .zip(d.chunks_exact(per));
-            for (((xb, gb), db), &e) in blocks.zip(values) {
-                let slope: f64 = gb
-                    .iter()
-                    .zip(db)
-                    .map(|(g, d)| (*g as f64) * (*d as f64))
-                    .sum();
-                if slope <= 1e-20 || e <= 0.0 {
-                    continue;
-                }
-                let d_max = db
-                    .iter()
-                    .enumerate()
-                    .filter(|(k, _)| moves(*k))
-                    .fold(0.0f32, |m, (_, v)| m.max(v.abs()));
-                if d_max == 0.0 {
-                    continue;
-                }
-                let s = ((fraction * e as f64 / slope) as f32).min(MAX_POLYAK_DELTA / d_max);
-                for (k, (x, d)) in xb.iter_mut().zip(db).enumerate() {
-                    if moves(k) {
-                        *x -= s * d;
-                    }
-                }
-            }
+            let mut c = vec![0.0; x.len()];
+            add_polyak_step(&mut c, g, d, values, step);
+            apply_capped(x, &c, term_block(x, values), (width, moving));
         }
     }
 }

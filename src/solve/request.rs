@@ -129,6 +129,13 @@ impl Solver {
                 Err(format!("`{name}` must be finite"))
             }
         };
+        let flag = |off: &str, on: &str| -> Result<bool, String> {
+            match count()? {
+                0 => Ok(false),
+                1 => Ok(true),
+                _ => Err(format!("`{name}` is 0 ({off}) or 1 ({on})")),
+            }
+        };
         let (solver, knobs) = (self.name(), self.knob_names().join(", "));
         let unknown = || format!("solver `{solver}` has no knob `{name}`; it has: {knobs}");
         match self {
@@ -145,33 +152,14 @@ impl Solver {
                 "smooth" => c.smooth_frames = real()? as f32,
                 "feet" => c.foot_lock = real()? as f32,
                 "early_root" => {
-                    c.early_root_only = match count()? {
-                        0 => false,
-                        1 => true,
-                        _ => return Err("`early_root` is 0 (every column) or 1 (root columns only before the late steps)".into()),
-                    }
+                    c.early_root_only =
+                        flag("every column", "root columns only before the late steps")?
                 }
                 "split" => {
-                    c.split_terms = match count()? {
-                        0 => false,
-                        1 => true,
-                        _ => return Err("`split` is 0 (one step for the whole error) or 1 (a step per statement)".into()),
-                    }
+                    c.split_terms = flag("one step for the whole error", "a step per statement")?
                 }
-                "skeleton" => {
-                    c.keep_skeleton = match count()? {
-                        0 => false,
-                        1 => true,
-                        _ => return Err("`skeleton` is 0 (off) or 1 (keep bone lengths)".into()),
-                    }
-                }
-                "freeze" => {
-                    c.freeze_first_frame = match count()? {
-                        0 => false,
-                        1 => true,
-                        _ => return Err("`freeze` is 0 (off) or 1 (first frame frozen)".into()),
-                    }
-                }
+                "skeleton" => c.keep_skeleton = flag("off", "keep bone lengths")?,
+                "freeze" => c.freeze_first_frame = flag("off", "first frame frozen")?,
                 _ => return Err(unknown()),
             },
             Solver::Latent(c) => match name {
@@ -179,19 +167,13 @@ impl Solver {
                 "iterations" => c.iterations = count()?,
                 "lr" => c.lr = real()?,
                 "relax" => {
-                    c.relax = match count()? {
-                        0 => super::latent::Relax::None,
-                        1 => super::latent::Relax::RigidXz,
-                        _ => return Err("`relax` is 0 (off) or 1 (rigid XZ)".into()),
+                    c.relax = if flag("off", "rigid XZ")? {
+                        super::latent::Relax::RigidXz
+                    } else {
+                        super::latent::Relax::None
                     }
                 }
-                "skeleton" => {
-                    c.keep_skeleton = match count()? {
-                        0 => false,
-                        1 => true,
-                        _ => return Err("`skeleton` is 0 (off) or 1 (keep bone lengths)".into()),
-                    }
-                }
+                "skeleton" => c.keep_skeleton = flag("off", "keep bone lengths")?,
                 _ => return Err(unknown()),
             },
             Solver::Ik(c) => match name {
@@ -209,13 +191,7 @@ impl Solver {
                 "history" => c.history = count()?,
                 "max_iter" => c.max_iter = count()?,
                 "lr" => c.lr = real()?,
-                "skeleton" => {
-                    c.keep_skeleton = match count()? {
-                        0 => false,
-                        1 => true,
-                        _ => return Err("`skeleton` is 0 (off) or 1 (keep bone lengths)".into()),
-                    }
-                }
+                "skeleton" => c.keep_skeleton = flag("off", "keep bone lengths")?,
                 _ => return Err(unknown()),
             },
         }
