@@ -2,7 +2,8 @@
 # Renders every program in programs/ into book/src/images/cookbook/ (a PNG strip and the
 # per-statement error table each) with `guide` at its defaults (without the unguided
 # DDPM-1000 comparison, which would double its time) and with `latent` at a CPU-sized
-# chain (with the unguided DDIM-10 sample next to it), then regenerates the cookbook pages
+# chain (with the unguided DDIM-10 sample next to it), programs with several people also
+# with `lbfgs` (InterControl's solver) at its defaults, then regenerates the cookbook pages
 # so they include them. The runs are listed in src/docgen/book.rs (COOKBOOK_RENDERS).
 # Run from the repository root; about one minute per program for guide and 1.5 for
 # latent on a 2-core CPU (19 programs: about 50 minutes).
@@ -19,5 +20,10 @@ for prog in programs/*.mprog; do
     echo "== $stem (latent)"
     $mprog run "$prog" --solver latent --knob ddim_steps=10 --knob iterations=30 --knob lr=0.02 \
         --seed 1 -o "$out/$stem-latent.png" | tee "$out/$stem-latent.md"
+    if grep -q '^people' "$prog"; then
+        echo "== $stem (lbfgs)"
+        $mprog run "$prog" --solver lbfgs --seed 1 --no-baseline -o "$out/$stem-lbfgs.png" \
+            | tee "$out/$stem-lbfgs.md"
+    fi
 done
 $mprog doc book

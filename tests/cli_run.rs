@@ -148,3 +148,36 @@ fn quick_task_bench_writes_a_table_for_the_chosen_solvers() {
     assert!(!out.status.success());
     assert!(text(&out).1.contains("not in this run"));
 }
+
+#[test]
+fn spacing_sets_where_the_people_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let prog = program(
+        dir.path(),
+        "people a \"a person waves\", b \"a person waves\"\nspacing 1.2 m\nlength 1s\nalways { separation(a, b, 0.5 m) }\n",
+    );
+    let npy = dir.path().join("out.npy");
+    let out = run(&[
+        "run",
+        &prog,
+        "--solver",
+        "plain",
+        "--knob",
+        "steps=5",
+        "--no-baseline",
+        "-o",
+        npy.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let array = mprog::formats::npy::read_npy(&npy).unwrap();
+    assert_eq!(array.shape, vec![2, 20, 22, 3]);
+    // Pelvis (joint 0) of each person at frame 0: the solvers pin it to the placement.
+    let pelvis = |p: usize| {
+        let i = p * 20 * 22 * 3;
+        (array.data[i], array.data[i + 2])
+    };
+    let ((ax, az), (bx, bz)) = (pelvis(0), pelvis(1));
+    let d = ((ax - bx).powi(2) + (az - bz).powi(2)).sqrt();
+    assert!((d - 1.2).abs() < 0.02, "start distance {d}");
+}

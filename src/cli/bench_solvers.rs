@@ -60,7 +60,8 @@ fn timed(
         ))
         .expect("template"),
     );
-    let req = SolveRequest::new(prompts.to_vec(), program.length(), seed, solver);
+    let req = SolveRequest::new(prompts.to_vec(), program.length(), seed, solver)
+        .placed(program.placements());
     let error: &dyn mprog::solve::MotionError = program;
     let out = solve(
         &Prior::from_bundle(bundle),

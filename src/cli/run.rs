@@ -158,14 +158,16 @@ pub fn run(args: RunArgs) -> Result<()> {
         .into_diagnostic()
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
     let frames = program.length();
-    let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.clone());
+    let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.clone())
+        .placed(program.placements());
     let result = solve_with_bar(&bundle, &req, &program, &device, solver.name())?;
     let people = &result.motions[0];
     let guided = per_statement(&program, people, &device)?;
     let baseline = if args.no_baseline {
         None
     } else {
-        let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.unguided());
+        let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.unguided())
+            .placed(program.placements());
         let r = solve_with_bar(&bundle, &req, &program, &device, "unguided")?;
         Some((per_statement(&program, &r.motions[0], &device)?, r.seconds))
     };

@@ -76,13 +76,15 @@ fn first_sentence(prose: &str) -> String {
 
 /// The solver runs `scripts/cookbook-renders.sh` makes for every program: (file suffix,
 /// solver, extra `mprog run` arguments).
-pub const COOKBOOK_RENDERS: [(&str, &str, &str); 2] = [
+pub const COOKBOOK_RENDERS: [(&str, &str, &str); 3] = [
     ("", "guide", " --no-baseline"),
     (
         "-latent",
         "latent",
         " --knob ddim_steps=10 --knob iterations=30 --knob lr=0.02",
     ),
+    // InterControl's own solver, rendered for programs with several people only.
+    ("-lbfgs", "lbfgs", " --no-baseline"),
 ];
 
 /// Where `scripts/cookbook-renders.sh` puts a program's result with the solver of `suffix`.

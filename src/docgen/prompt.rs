@@ -165,8 +165,9 @@ with one complete program in a ```mprog code block, and nothing the language lac
   face to face). P ≥ 3 people stand on a circle with neighbours 2 m apart, all facing
   its centre (0, 0, r), r = 1 / sin(180°/P) (1.15 m for three): the first at the origin
   facing +Z, the next ones going round to the first one's right (−X side), so with three
-  people `b` stands front-right of `a` and `c` front-left. Anything closer than 2 m
-  (holding hands, hugging) they walk to.
+  people `b` stands front-right of `a` and `c` front-left. `spacing 1 m` (a header
+  line, 0.4–20 m) puts neighbours that far apart instead: use it when people touch from
+  the start (holding hands: about 1 m), else they must walk to each other first.
 - The person is about 1.6 m tall: pelvis ≈ 0.92 m, head joint ≈ 1.48 m when standing
   (table below). Arms are about 0.6 m long (shoulder to wrist), legs about 0.85 m.
   Across the body: hips ±0.06–0.1 m from the pelvis in x, feet ±0.1–0.25 m (by stance),
@@ -216,7 +217,7 @@ minimize norm(acc(r_hand))             # any scalar
 - `at` takes a list of times; `during` takes one range (write two blocks for two).
   `end - 2s`, `1.5s`, `-x`, and expressions inside vectors (`[0, 0, d]`) are all fine.
 - `a.pelvis@start` is `(a.pelvis)@start`; `f@start` works on a loop variable.
-- Reserved, not usable as names: `prompt length param def let always at during for in if
+- Reserved, not usable as names: `prompt length spacing param def let always at during for in if
   else weight minimize maximize and or not x y z xz me joints people start mid end true
   false`.
 - Functions may take people: `def hold(p, q) = dist(p.r_hand, q.l_hand) < 10 cm`;

@@ -231,6 +231,9 @@ pub struct Ir {
     pub people: usize,
     /// Declared length in frames.
     pub length: usize,
+    /// Declared spacing of the people's start placements in metres (`None`: the default).
+    #[serde(default)]
+    pub spacing: Option<f64>,
 }
 
 /// What evaluating a program costs, estimated at the declared length.
@@ -255,6 +258,15 @@ impl CostEstimate {
 }
 
 impl Ir {
+    /// Where each person starts: the default placements, `spacing` metres apart when the
+    /// program declares one.
+    pub fn start_placements(&self) -> Vec<crate::solve::Placement> {
+        let spacing = self
+            .spacing
+            .map_or(crate::solve::DEFAULT_SPACING, |s| s as f32);
+        crate::solve::Placement::defaults(self.people, spacing)
+    }
+
     /// Frame indices of a domain for a motion of `f` frames.
     pub fn resolve_domain(&self, d: DomainId, f: usize) -> Vec<usize> {
         let last = f.max(1) - 1;

@@ -199,6 +199,11 @@ impl Program {
         &self.checked.header.people
     }
 
+    /// Where each person starts (the `spacing` line, else the default placements).
+    pub fn placements(&self) -> Vec<crate::solve::Placement> {
+        self.checked.ir.start_placements()
+    }
+
     /// Parameters after overrides.
     pub fn params(&self) -> &[ParamInfo] {
         &self.checked.header.params

@@ -74,7 +74,8 @@ impl Vocabulary {
     }
 
     /// Token ids of a prompt, and the words it did not know (stop words are silently
-    /// skipped; they are not "unknown").
+    /// skipped; they are not "unknown"). An unseen inflection of a known word is read as
+    /// that word ([`Self::known_form`]).
     pub fn tokenize(&self, text: &str) -> (Vec<usize>, Vec<String>) {
         let mut ids = Vec::new();
         let mut unknown = Vec::new();
@@ -82,11 +83,69 @@ impl Vocabulary {
             match self.words.get(&w) {
                 Some(&id) => ids.push(id),
                 None if STOP_WORDS.contains(&w.as_str()) => {}
-                None => unknown.push(w),
+                None => match self.known_form(&w) {
+                    Some(known) => ids.push(self.words[known]),
+                    None => unknown.push(w),
+                },
             }
         }
         ids.truncate(self.max_tokens);
         (ids, unknown)
+    }
+
+    /// `(word, known word it is read as)` for each word of a prompt that is not in the
+    /// vocabulary but is an inflection of a word that is.
+    pub fn respellings(&self, text: &str) -> Vec<(String, String)> {
+        words_of(text)
+            .into_iter()
+            .filter(|w| !self.words.contains_key(w))
+            .filter_map(|w| {
+                let known = self.known_form(&w)?.to_string();
+                Some((w, known))
+            })
+            .collect()
+    }
+
+    /// The vocabulary word an unseen inflection stands for: captions say "walks forward"
+    /// and "walking", prompts "walked forwards" or "jogging". Tries the word with a plural
+    /// or verb ending taken off or swapped ("forwards" → "forward", "walked" → "walks",
+    /// "jogging" → "jogs", "waving" → "waves", "turning" → "turn"); `None` if no
+    /// candidate is known. Short words are left alone (too easy to mis-read).
+    pub fn known_form(&self, word: &str) -> Option<&str> {
+        if word.len() < 4 || !word.is_ascii() {
+            return None;
+        }
+        let mut candidates = Vec::new();
+        let mut stems = |stem: &str| {
+            // "jogg" → "jog", "stepp" → "step": a doubled last consonant.
+            let b = stem.as_bytes();
+            let undoubled = (b.len() >= 3 && b[b.len() - 1] == b[b.len() - 2])
+                .then(|| stem[..stem.len() - 1].to_string());
+            for s in std::iter::once(stem.to_string()).chain(undoubled) {
+                candidates.push(s.clone());
+                candidates.push(format!("{s}s"));
+                candidates.push(format!("{s}es"));
+                candidates.push(format!("{s}ing"));
+            }
+        };
+        if let Some(stem) = word.strip_suffix("ing") {
+            stems(stem);
+            stems(&format!("{stem}e"));
+        } else if let Some(stem) = word.strip_suffix("ed") {
+            stems(stem);
+            stems(&format!("{stem}e"));
+        } else if let Some(stem) = word.strip_suffix("ly") {
+            stems(stem);
+        } else if let Some(stem) = word.strip_suffix('s') {
+            stems(stem);
+        } else {
+            stems(word);
+        }
+        candidates.iter().find_map(|c| {
+            self.words
+                .get_key_value(c.as_str())
+                .map(|(k, _)| k.as_str())
+        })
     }
 }
 
@@ -178,6 +237,44 @@ mod tests {
         assert_eq!(ids.len(), 2);
         assert_eq!(unknown, vec!["moonwalks".to_string()]);
         assert!(!v.words.contains_key("a"));
+    }
+
+    #[test]
+    fn unseen_inflections_read_as_known_words() {
+        let v = Vocabulary::from_captions(
+            [
+                "a person walks forward",
+                "a man jogs",
+                "someone waves",
+                "a person turns left",
+                "a person is walking",
+            ],
+            16,
+        );
+        for (word, known) in [
+            ("forwards", "forward"),
+            ("walked", "walks"),
+            ("walk", "walks"),
+            ("jogging", "jogs"),
+            ("waving", "waves"),
+            ("waved", "waves"),
+            ("turning", "turns"),
+        ] {
+            assert_eq!(v.known_form(word), Some(known), "{word}");
+        }
+        for word in ["moonwalks", "sits", "slowly", "jogger", "act"] {
+            assert_eq!(v.known_form(word), None, "{word}");
+        }
+        let (ids, unknown) = v.tokenize("A man walked forwards, slowly");
+        assert_eq!(ids.len(), 3);
+        assert_eq!(unknown, vec!["slowly".to_string()]);
+        assert_eq!(
+            v.respellings("A man walked forwards"),
+            vec![
+                ("walked".to_string(), "walks".to_string()),
+                ("forwards".to_string(), "forward".to_string())
+            ]
+        );
     }
 
     #[test]

@@ -11,9 +11,9 @@ use crate::skeleton::all_joint_names;
 
 /// Language keywords and the time words.
 pub const KEYWORDS: &[&str] = &[
-    "prompt", "length", "param", "people", "def", "let", "always", "at", "during", "for", "in",
-    "if", "else", "weight", "minimize", "maximize", "and", "or", "not", "start", "mid", "end",
-    "joints", "me",
+    "prompt", "length", "spacing", "param", "people", "def", "let", "always", "at", "during",
+    "for", "in", "if", "else", "weight", "minimize", "maximize", "and", "or", "not", "start",
+    "mid", "end", "joints", "me",
 ];
 
 /// Commands whose argument is a file name.

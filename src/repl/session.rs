@@ -305,7 +305,8 @@ impl Session {
         let Some(prompts) = program.prompts().into_iter().collect::<Option<Vec<_>>>() else {
             return Reply::error("every person needs a prompt: add `prompt \"…\"` to the program");
         };
-        let req = SolveRequest::new(prompts, program.length(), seed, solver.clone());
+        let req = SolveRequest::new(prompts, program.length(), seed, solver.clone())
+            .placed(program.placements());
         let device = self.device.clone();
         let error: &dyn crate::solve::MotionError = &program;
         let result = match self.bundle() {

@@ -244,6 +244,14 @@ impl SolveRequest {
             solver,
         }
     }
+
+    /// The same request with these start placements (one per person).
+    pub fn placed(self, placements: Vec<Placement>) -> Self {
+        SolveRequest {
+            placements: Some(placements),
+            ..self
+        }
+    }
 }
 
 /// What a solve produced.

@@ -85,6 +85,7 @@ pub fn run_task(
     };
     let req = SolveRequest {
         samples: task.samples,
+        placements: task.placements(),
         ..SolveRequest::new(task.prompts.clone(), task.frames, seed, solver.clone())
     };
     let error: &dyn crate::solve::MotionError = task;

@@ -64,6 +64,16 @@ impl Task {
     }
 }
 
+impl Task {
+    /// Start placements of a program's people (`None`: the defaults).
+    pub fn placements(&self) -> Option<Vec<crate::solve::Placement>> {
+        match &self.goal {
+            Goal::Program(p) => Some(p.placements()),
+            Goal::Keyframes(_) => None,
+        }
+    }
+}
+
 impl MotionError for Task {
     fn error(&self, joints: Tensor<5>) -> Tensor<1> {
         Task::error(self, joints)

@@ -238,7 +238,7 @@ fn node_bounds(ir: &Ir, starts: &[Placement], pick: Pick) -> Vec<Bounds> {
 /// bounded tighter (less time to travel); when the error can never be negative, a positive
 /// bound on that one frame alone makes the mean positive too.
 pub fn never_met(ir: &Ir) -> Vec<(usize, f64)> {
-    let starts = Placement::defaults(ir.people, crate::solve::DEFAULT_SPACING);
+    let starts = ir.start_placements();
     let every = node_bounds(ir, &starts, Pick::Latest);
     let first = node_bounds(ir, &starts, Pick::Earliest);
     let lowest = |b: &Bounds| b.iter().map(|x| x.lo).fold(f64::INFINITY, f64::min);
@@ -284,6 +284,9 @@ mod tests {
         }
         let two = "length 4s\npeople a \"x\", b \"y\"\nat start { groundDist(a.pelvis, b.pelvis) < 1 m }\n";
         assert_eq!(flagged(two), 1);
+        // Placed 0.8 m apart by `spacing`, the same start is possible.
+        let close = two.replace("length 4s", "length 4s\nspacing 80 cm");
+        assert_eq!(flagged(&close), 0);
     }
 
     #[test]

@@ -2,12 +2,18 @@
 //! length, user functions (duplicates, reserved names, recursion), and the library's
 //! functions and constants.
 
+use super::units::Unit;
 use super::values::{Cx, Val};
 use super::{Checker, MAX_LENGTH, MODEL_MAX_FRAMES, ParamInfo, PersonInfo};
 use crate::lang::diag::{Diagnostic, did_you_mean};
 use crate::lang::syntax::ast::*;
 use crate::skeleton::joint_index;
 use std::collections::{HashMap, HashSet};
+
+/// Closest start spacing (m): two torsos side by side.
+const MIN_SPACING: f64 = 0.4;
+/// Farthest start spacing (m).
+const MAX_SPACING: f64 = 20.0;
 
 /// Names a person, parameter or function may not take.
 pub const RESERVED: &[&str] = &[
@@ -87,6 +93,7 @@ impl<'a> Checker<'a> {
             }
         }
         self.declare_length(module, &cx);
+        self.declare_spacing(module, &cx);
     }
 
     fn duplicate_header(&mut self, cx: &Cx, what: &str, span: Span, first: Span) {
@@ -331,6 +338,81 @@ impl<'a> Checker<'a> {
             unit_value: num.unit,
             span,
         });
+    }
+
+    /// `spacing 1 m`: a constant distance, for two or more people.
+    fn declare_spacing(&mut self, module: &'a Module, cx: &Cx) {
+        let mut first: Option<Span> = None;
+        for item in &module.items {
+            let Item::Spacing { value, span } = item else {
+                continue;
+            };
+            if let Some(f) = first {
+                self.duplicate_header(cx, "spacing", *span, f);
+                continue;
+            }
+            first = Some(*span);
+            if !self.multi {
+                self.error(
+                    cx,
+                    "mprog::spacing_needs_people",
+                    *span,
+                    "`spacing` places several people, and this program has one",
+                )
+                .label("one person")
+                .help("declare the people first: `people a \"…\", b \"…\"`, or remove this line");
+                continue;
+            }
+            let val = self.expr(value, &None, cx);
+            let metres = match val {
+                Val::Num(n) if !n.vector && (n.unit == Unit::M || n.unit.free) => {
+                    // Rounded to the millimetre: the constant is stored in f32.
+                    self.b
+                        .const_of(n.node)
+                        .map(|v| (f64::from(v[0]) * 1e3).round() / 1e3)
+                }
+                Val::Error => continue,
+                _ => {
+                    let what = match val {
+                        Val::Num(n) if !n.vector => format!("a quantity in {}", n.unit),
+                        _ => val.describe().to_string(),
+                    };
+                    self.error(
+                        cx,
+                        "mprog::type_mismatch",
+                        value.span,
+                        format!("`spacing` needs a distance in metres, not {what}"),
+                    )
+                    .help("write e.g. `spacing 1 m` or `spacing 80 cm`");
+                    continue;
+                }
+            };
+            let Some(metres) = metres else {
+                self.error(
+                    cx,
+                    "mprog::not_constant",
+                    value.span,
+                    "the spacing must be constant",
+                )
+                .label("depends on the motion")
+                .help("write a fixed distance such as `spacing 1 m`");
+                continue;
+            };
+            if !(MIN_SPACING..=MAX_SPACING).contains(&metres) {
+                self.error(
+                    cx,
+                    "mprog::bad_spacing",
+                    value.span,
+                    format!("a spacing of {metres} m is out of range"),
+                )
+                .label("here")
+                .help(format!(
+                    "people start {MIN_SPACING} m to {MAX_SPACING} m apart; closer than that their bodies overlap"
+                ));
+                continue;
+            }
+            self.header.spacing = Some(metres);
+        }
     }
 
     fn declare_length(&mut self, module: &'a Module, cx: &Cx) {

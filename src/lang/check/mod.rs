@@ -83,6 +83,8 @@ pub struct Header {
     pub length: usize,
     /// People in tensor order.
     pub people: Vec<PersonInfo>,
+    /// `spacing`: metres between neighbouring people at the start (`None`: the default).
+    pub spacing: Option<f64>,
     /// Parameters.
     pub params: Vec<ParamInfo>,
 }
@@ -372,6 +374,7 @@ impl Checker<'_> {
             statements,
             people: self.header.people.len(),
             length: self.header.length,
+            spacing: self.header.spacing,
         }
     }
 }

@@ -47,6 +47,8 @@ pub enum Item {
     Prompt { text: String, span: Span },
     /// `length 6s`.
     Length { value: Expr, span: Span },
+    /// `spacing 1 m`: metres between neighbouring people at the start.
+    Spacing { value: Expr, span: Span },
     /// `param name = value`.
     Param {
         name: Ident,

@@ -132,6 +132,7 @@ fn rule_name(rule: &Rule) -> String {
         Rule::fn_block => "`{`",
         Rule::prompt_decl
         | Rule::length_decl
+        | Rule::spacing_decl
         | Rule::param_decl
         | Rule::people_decl
         | Rule::def_decl
@@ -245,6 +246,10 @@ impl Builder<'_> {
                 Item::Prompt { text, span }
             }
             Rule::length_decl => Item::Length {
+                value: self.expr(pair.into_inner().next()?),
+                span,
+            },
+            Rule::spacing_decl => Item::Spacing {
                 value: self.expr(pair.into_inner().next()?),
                 span,
             },
