@@ -181,3 +181,30 @@ fn spacing_sets_where_the_people_start() {
     let d = ((ax - bx).powi(2) + (az - bz).powi(2)).sqrt();
     assert!((d - 1.2).abs() < 0.02, "start distance {d}");
 }
+
+#[test]
+fn gen_says_how_it_read_the_prompt() {
+    let dir = tempfile::tempdir().unwrap();
+    let npy = dir.path().join("out.npy");
+    let out = run(&[
+        "gen",
+        "--text",
+        "a man walked forwards, moonwalking",
+        "--frames",
+        "10",
+        "--steps",
+        "2",
+        "-o",
+        npy.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("read as words the model knows: walked → walks, forwards → forward"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("ignored words the model does not know: moonwalking"),
+        "{stderr}"
+    );
+}

@@ -104,20 +104,8 @@ pub fn run(args: GenArgs) -> Result<()> {
         other => other.into_diagnostic()?,
     };
     bar.finish_and_clear();
-    let read_as: Vec<String> = bundle
-        .vocab
-        .respellings(&args.text)
-        .into_iter()
-        .map(|(word, known)| format!("{word} → {known}"))
-        .collect();
-    if !read_as.is_empty() {
-        eprintln!("read as words the model knows: {}", read_as.join(", "));
-    }
-    if let Some(unknown) = out.unknown_words.first().filter(|u| !u.is_empty()) {
-        eprintln!(
-            "ignored words the model does not know: {}",
-            unknown.join(", ")
-        );
+    for line in bundle.vocab.word_report(&args.text) {
+        eprintln!("{line}");
     }
     let mut meta = Meta::new();
     meta.insert("text".into(), args.text.clone().into());

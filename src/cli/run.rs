@@ -157,6 +157,16 @@ pub fn run(args: RunArgs) -> Result<()> {
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
+    let several = prompts.len() > 1;
+    for (person, prompt) in program.people().iter().zip(&prompts) {
+        for line in bundle.vocab.word_report(prompt) {
+            if several {
+                eprintln!("{}: {line}", person.name);
+            } else {
+                eprintln!("{line}");
+            }
+        }
+    }
     let frames = program.length();
     let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.clone())
         .placed(program.placements());

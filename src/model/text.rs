@@ -106,6 +106,31 @@ impl Vocabulary {
             .collect()
     }
 
+    /// What the model makes of a prompt's words, as lines for the user: the words read
+    /// as a known inflection and the words ignored (none when every word is known).
+    pub fn word_report(&self, text: &str) -> Vec<String> {
+        let mut lines = Vec::new();
+        let read_as: Vec<String> = self
+            .respellings(text)
+            .into_iter()
+            .map(|(word, known)| format!("{word} → {known}"))
+            .collect();
+        if !read_as.is_empty() {
+            lines.push(format!(
+                "read as words the model knows: {}",
+                read_as.join(", ")
+            ));
+        }
+        let unknown = self.tokenize(text).1;
+        if !unknown.is_empty() {
+            lines.push(format!(
+                "ignored words the model does not know: {}",
+                unknown.join(", ")
+            ));
+        }
+        lines
+    }
+
     /// The vocabulary word an unseen inflection stands for: captions say "walks forward"
     /// and "walking", prompts "walked forwards" or "jogging". Tries the word with a plural
     /// or verb ending taken off or swapped ("forwards" → "forward", "walked" → "walks",
@@ -268,6 +293,14 @@ mod tests {
         let (ids, unknown) = v.tokenize("A man walked forwards, slowly");
         assert_eq!(ids.len(), 3);
         assert_eq!(unknown, vec!["slowly".to_string()]);
+        assert_eq!(
+            v.word_report("A man walked forwards, slowly"),
+            vec![
+                "read as words the model knows: walked → walks, forwards → forward",
+                "ignored words the model does not know: slowly"
+            ]
+        );
+        assert!(v.word_report("a man walks forward").is_empty());
         assert_eq!(
             v.respellings("A man walked forwards"),
             vec![
