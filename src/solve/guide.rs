@@ -57,6 +57,15 @@
 //! term with a step of its own it held the feet so firmly that the hands could not meet.
 //! A single-statement program steps exactly as before.
 //!
+//! A knob, off by default, preconditions the late steps ([`GuideConfig::late_root_scale`],
+//! `late_root`): it scales the root columns of each step direction. Moving the root moves
+//! every joint of every later frame, so the root's gradient dwarfs the pose's and the step
+//! goes to the path: two people asked to hold hands were walked into each other (pelvises
+//! 0.47 m apart against 0.75 m asked) with their wrists at 0.87 m on every frame, 0.53 m
+//! off. At 0.01 the late steps lift and bend the arms instead (0.0006 m). It is not the
+//! default: on the single-person programs it helped some (HSI-2, GEO-1) and hurt others
+//! (HOI-1, HOD-1, HSI-4), whose late steps still need to move the path.
+//!
 //! The denoiser is not in the inner loop: only FK, the error and its gradient are, through
 //! the fused host path ([`super::host`]) by default.
 //!
@@ -173,6 +182,12 @@ pub struct GuideConfig {
     /// statement) on its own and step along the sum (see the module notes); `false` sizes
     /// one step for the whole error. Needs the fused path.
     pub split_terms: bool,
+    /// In the last `late_steps` steps, the root columns' share of each step direction
+    /// (a diagonal preconditioner, 0..=1; 1: the plain gradient). Moving the root moves
+    /// every joint of every later frame, so its gradient dominates: a contact the prompt
+    /// does not make is met by walking the people into each other. Small values make the
+    /// late steps meet it with the pose instead (see the module notes).
+    pub late_root_scale: f32,
 }
 
 impl Default for GuideConfig {
@@ -193,6 +208,7 @@ impl Default for GuideConfig {
             foot_lock: 1.0,
             early_root_only: true,
             split_terms: true,
+            late_root_scale: 1.0,
         }
     }
 }
@@ -229,6 +245,11 @@ impl GuideConfig {
         if self.early_root_only && !self.fused {
             return Err(SolveError::Invalid(
                 "guide: early root-only steps need the fused inner loop (set fused or early_root to 0)".into(),
+            ));
+        }
+        if !(self.late_root_scale.is_finite() && (0.0..=1.0).contains(&self.late_root_scale)) {
+            return Err(SolveError::Invalid(
+                "guide: late_root (the root columns' share of the late steps) must be between 0 and 1".into(),
             ));
         }
         if self.split_terms && !self.fused {
@@ -377,6 +398,11 @@ fn guide_fused(
     // conflict over the path each pulled it their own way (HSI-4's "duck under the barrier"
     // met by stopping short of it, against "end past it": 0.76 m short).
     let split = cfg.split_terms && cfg.step_rule == StepRule::Polyak && i < cfg.late_steps;
+    let root_scale = if i < cfg.late_steps {
+        cfg.late_root_scale
+    } else {
+        1.0
+    };
     let mut terms = TermGradients::default();
     let mut combined = vec![0.0; head.len()];
     let mut total = Vec::new();
@@ -390,7 +416,8 @@ fn guide_fused(
             for (term, g) in terms.values.iter().zip(terms.grads.iter_mut()) {
                 ensure_finite(term, "guide", "error", || at(it))?;
                 ensure_finite(g, "guide", "gradient", || at(it))?;
-                let dir = step_direction(ctx, cfg, g, HEAD, sigma);
+                let mut dir = step_direction(ctx, cfg, g, HEAD, sigma);
+                scale_root(&mut dir, root_scale);
                 add_polyak_step(&mut combined, g, &dir, term, step);
             }
             let per = term_block(&head, &values);
@@ -404,7 +431,8 @@ fn guide_fused(
         total.extend(values.iter().zip(objective.penalty()).map(|(e, p)| e + p));
         ensure_finite(&values, "guide", "error", || at(it))?;
         ensure_finite(&grad, "guide", "gradient", || at(it))?;
-        let dir = step_direction(ctx, cfg, &mut grad, HEAD, sigma);
+        let mut dir = step_direction(ctx, cfg, &mut grad, HEAD, sigma);
+        scale_root(&mut dir, root_scale);
         // Early root-only steps take the step the full gradient calls for, on the root
         // columns alone: restricting the direction must not enlarge the step (a pose error
         // with a small root gradient would otherwise push the root height by metres).
@@ -438,6 +466,17 @@ fn step_direction(
         }
     }
     dir
+}
+
+/// Scales the root columns of a `[.., HEAD]` direction by `r` (a diagonal preconditioner:
+/// the Polyak step divides by ⟨g, d⟩, so it stays a descent step sized for the term).
+fn scale_root(dir: &mut [f32], r: f32) {
+    if r == 1.0 {
+        return;
+    }
+    for row in dir.chunks_exact_mut(HEAD) {
+        row[..ROOT_COLUMNS].iter_mut().for_each(|d| *d *= r);
+    }
 }
 
 /// The same K steps through the burn graph (decoder + error, autodiff).

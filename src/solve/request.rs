@@ -95,6 +95,7 @@ impl Solver {
                 "feet",
                 "early_root",
                 "split",
+                "late_root",
             ],
             Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax", "skeleton"],
             Solver::Ik(_) => &["ddim_steps", "iterations", "lr", "smoothness"],
@@ -151,6 +152,7 @@ impl Solver {
                 "tau" => c.tau = real()? as f32,
                 "smooth" => c.smooth_frames = real()? as f32,
                 "feet" => c.foot_lock = real()? as f32,
+                "late_root" => c.late_root_scale = real()? as f32,
                 "early_root" => {
                     c.early_root_only =
                         flag("every column", "root columns only before the late steps")?

@@ -1107,3 +1107,64 @@ fn a_stiff_statement_does_not_set_the_pace_of_the_others() {
         whole.error
     );
 }
+
+/// Pelvis at least 1.6 m up on every frame: only the root columns (its height) meet it.
+fn pelvis_up(j: Tensor<5>) -> Tensor<1> {
+    let [b, _, n, _, _] = j.dims();
+    let y = joint(j, 0).narrow(4, 1, 1);
+    (y.neg() + 1.6)
+        .clamp_min(0.0)
+        .reshape([b, n])
+        .mean_dim(1)
+        .reshape([b])
+}
+
+#[test]
+fn late_root_scale_leaves_the_path_and_moves_the_pose() {
+    let bundle = tiny_bundle();
+    // Every step a late step, so the scale applies throughout.
+    let guide = |late_root_scale| {
+        Solver::Guide(GuideConfig {
+            steps: 20,
+            late_steps: 20,
+            k_late: 30,
+            late_root_scale,
+            ..GuideConfig::default()
+        })
+    };
+    let error = |s: Solver, err: &dyn MotionError| {
+        run(&bundle, &request(&["a person walks"], s), err).error[0]
+    };
+    let plain = |err: &dyn MotionError| error(guide(1.0).unguided(), err);
+    let (wrist_plain, pelvis_plain) = (plain(&wrist_up), plain(&pelvis_up));
+    assert!(
+        wrist_plain > 0.1 && pelvis_plain > 0.1,
+        "{wrist_plain} {pelvis_plain}"
+    );
+    // Without the root, a wrist target is still met (by the pose)…
+    let wrist = error(guide(0.0), &wrist_up);
+    assert!(wrist < 0.2 * wrist_plain, "{wrist} vs {wrist_plain}");
+    // …but a target only the root can meet is left to the denoiser.
+    let pelvis_fixed = error(guide(0.0), &pelvis_up);
+    let pelvis_free = error(guide(1.0), &pelvis_up);
+    assert!(
+        pelvis_free < 0.2 * pelvis_plain,
+        "{pelvis_free} vs {pelvis_plain}"
+    );
+    assert!(
+        pelvis_fixed > 0.5 * pelvis_plain,
+        "{pelvis_fixed} vs {pelvis_plain}"
+    );
+    let mut knob = guide(1.0);
+    knob.set_knob("late_root", 0.01).unwrap();
+    assert!(matches!(&knob, Solver::Guide(c) if c.late_root_scale == 0.01));
+    knob.set_knob("late_root", 1.5).unwrap();
+    let refused = solve(
+        &Prior::from_bundle(&bundle),
+        &request(&["a person walks"], knob),
+        &wrist_up,
+        &Device::flex(),
+        |_| {},
+    );
+    assert!(matches!(refused, Err(SolveError::Invalid(m)) if m.contains("late_root")));
+}
