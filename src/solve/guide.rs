@@ -134,7 +134,7 @@ pub enum StepRule {
 }
 
 /// Root columns of a feature row: yaw velocity, XZ velocity, height.
-const ROOT_COLUMNS: usize = 4;
+pub(crate) const ROOT_COLUMNS: usize = 4;
 
 /// Largest change of one normalised feature in one Polyak iteration.
 pub const MAX_POLYAK_DELTA: f32 = 0.5;

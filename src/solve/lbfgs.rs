@@ -16,6 +16,11 @@
 //! host path and `P(μ)` is written back ([`super::bones`]). InterControl's model was
 //! trained with joint-position losses; this one's features hold each joint on its own, and
 //! without the projection the late steps meet a contact by stretching an arm.
+//!
+//! Optionally ([`LbfgsConfig::early_root_only`], off by default) the steps before the last
+//! T_s optimise only the root columns, as `guide`'s do: the gradient is masked to them, so
+//! every L-BFGS direction and line search stays in that subspace and the pose is left to
+//! the denoiser (HSC-1's walker keeps walking instead of standing with its hand up).
 
 use super::SolveError;
 use super::host::{check_shape, extract_head, insert_head};
@@ -49,6 +54,9 @@ pub struct LbfgsConfig {
     /// In the last `late_steps` steps, optimise through the skeleton projection and write
     /// it back, as `guide` does.
     pub keep_skeleton: bool,
+    /// Before the last `late_steps` steps, optimise only the root columns (the path), as
+    /// `guide`'s early steps do; `false` (InterControl) edits every column from the start.
+    pub early_root_only: bool,
 }
 
 impl Default for LbfgsConfig {
@@ -62,6 +70,7 @@ impl Default for LbfgsConfig {
             max_iter: 4,
             lr: 1.0,
             keep_skeleton: true,
+            early_root_only: false,
         }
     }
 }
@@ -79,6 +88,20 @@ impl LbfgsConfig {
         }
         Ok(())
     }
+}
+
+/// `[1, 1, 263]`: 1 on the root columns (yaw velocity, XZ velocity, height), 0 elsewhere.
+fn root_mask(device: &Device) -> Tensor<3> {
+    let mask: Vec<f32> = (0..FEATURE_DIM)
+        .map(|k| {
+            if k < super::guide::ROOT_COLUMNS {
+                1.0
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    Tensor::from_data(TensorData::new(mask, [1, 1, FEATURE_DIM]), device)
 }
 
 /// The optimised variable: μ_t as a one-parameter module.
@@ -117,6 +140,10 @@ pub(crate) fn run(
         };
         let at = || format!("denoising step {}/{n}", n - i);
         let skeleton = cfg.keep_skeleton && i < cfg.late_steps && k > 0;
+        // Root-only steps: the gradient is masked to the root columns, so every L-BFGS
+        // direction (built from gradients) and its line search stay in that subspace.
+        let root_only =
+            (cfg.early_root_only && i >= cfg.late_steps).then(|| root_mask(&ctx.device));
         if skeleton {
             objective.project_skeleton(&extract_head(&host(mu.clone()), FEATURE_DIM));
         }
@@ -183,9 +210,14 @@ pub(crate) fn run(
                 if total.is_tracked() {
                     grads = GradientsParams::from_grads(total.backward(), &m);
                 }
-                if grads.get::<3>(m.x.id).is_none() {
-                    grads.register(m.x.id, Tensor::<3>::zeros(dims, &ctx.device));
-                }
+                let g = grads
+                    .remove::<3>(m.x.id)
+                    .unwrap_or_else(|| Tensor::zeros(dims, &ctx.device));
+                let g = match &root_only {
+                    Some(mask) => g * mask.clone(),
+                    None => g,
+                };
+                grads.register(m.x.id, g);
                 (value, grads)
             };
             let (next, loss) = lbfgs.step(cfg.lr, module, &mut closure);

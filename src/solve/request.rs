@@ -108,6 +108,7 @@ impl Solver {
                 "max_iter",
                 "lr",
                 "skeleton",
+                "early_root",
             ],
         }
     }
@@ -194,6 +195,10 @@ impl Solver {
                 "max_iter" => c.max_iter = count()?,
                 "lr" => c.lr = real()?,
                 "skeleton" => c.keep_skeleton = flag("off", "keep bone lengths")?,
+                "early_root" => {
+                    c.early_root_only =
+                        flag("every column", "root columns only before the late steps")?
+                }
                 _ => return Err(unknown()),
             },
         }

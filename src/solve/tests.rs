@@ -1168,3 +1168,45 @@ fn late_root_scale_leaves_the_path_and_moves_the_pose() {
     );
     assert!(matches!(refused, Err(SolveError::Invalid(m)) if m.contains("late_root")));
 }
+
+/// Right wrist at least 0.6 m above the head on every frame: only the pose meets it (the
+/// features hold joint heights apart from the root's).
+fn wrist_above_head(j: Tensor<5>) -> Tensor<1> {
+    let [b, _, n, _, _] = j.dims();
+    let rise = (joint(j.clone(), 20) - joint(j, 15)).narrow(4, 1, 1);
+    (rise.neg() + 0.6)
+        .clamp_min(0.0)
+        .reshape([b, n])
+        .mean_dim(1)
+        .reshape([b])
+}
+
+#[test]
+fn lbfgs_early_root_steps_leave_the_pose_to_the_model() {
+    let bundle = tiny_bundle();
+    // No late steps: every step is an early one.
+    let lbfgs = |early_root_only| {
+        Solver::Lbfgs(LbfgsConfig {
+            steps: 10,
+            late_steps: 0,
+            early_root_only,
+            ..LbfgsConfig::default()
+        })
+    };
+    let error = |s: Solver, err: &dyn MotionError| {
+        run(&bundle, &request(&["a person walks"], s), err).error[0]
+    };
+    let plain = error(lbfgs(false).unguided(), &wrist_above_head);
+    let every = error(lbfgs(false), &wrist_above_head);
+    let root = error(lbfgs(true), &wrist_above_head);
+    assert!(plain > 0.1, "{plain}");
+    assert!(every < 0.2 * plain, "every column: {every} vs {plain}");
+    assert!(root > 0.5 * plain, "root only: {root} vs {plain}");
+    // A target the path can meet is still met.
+    let pelvis_plain = error(lbfgs(false).unguided(), &pelvis_up);
+    let pelvis_root = error(lbfgs(true), &pelvis_up);
+    assert!(
+        pelvis_root < 0.2 * pelvis_plain,
+        "{pelvis_root} vs {pelvis_plain}"
+    );
+}
