@@ -109,6 +109,7 @@ impl Solver {
                 "lr",
                 "skeleton",
                 "early_root",
+                "smooth",
             ],
         }
     }
@@ -199,6 +200,7 @@ impl Solver {
                     c.early_root_only =
                         flag("every column", "root columns only before the late steps")?
                 }
+                "smooth" => c.smooth_frames = real()? as f32,
                 _ => return Err(unknown()),
             },
         }

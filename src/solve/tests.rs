@@ -1210,3 +1210,52 @@ fn lbfgs_early_root_steps_leave_the_pose_to_the_model() {
         "{pelvis_root} vs {pelvis_plain}"
     );
 }
+
+#[test]
+fn lbfgs_smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
+    let bundle = tiny_bundle();
+    let cfg = |smooth_frames| {
+        Solver::Lbfgs(LbfgsConfig {
+            steps: 30,
+            smooth_frames,
+            ..LbfgsConfig::default()
+        })
+    };
+    let wrist_y =
+        |r: &SolveResult| -> Vec<f32> { r.motions[0][0].frames.iter().map(|f| f[20].y).collect() };
+    let plain = wrist_y(&run(
+        &bundle,
+        &request(&["a person walks"], cfg(0.0).unguided()),
+        &wrist_up_at_8,
+    ));
+    // Largest frame-to-frame step of the edit around the keyframe, relative to the edit
+    // at the keyframe.
+    let jump = |smooth: f32| {
+        let r = run(
+            &bundle,
+            &request(&["a person walks"], cfg(smooth)),
+            &wrist_up_at_8,
+        );
+        assert!(r.error[0] < 0.05, "σ {smooth}: error {}", r.error[0]);
+        let edit: Vec<f32> = wrist_y(&r).iter().zip(&plain).map(|(a, b)| a - b).collect();
+        let step = (4..12)
+            .map(|t| (edit[t + 1] - edit[t]).abs())
+            .fold(0.0, f32::max);
+        step / edit[8].abs()
+    };
+    let (raw, smooth) = (jump(0.0), jump(4.0));
+    assert!(
+        smooth < 0.7 * raw,
+        "relative jump: raw {raw}, smoothed {smooth}"
+    );
+    let mut bad = cfg(4.0);
+    bad.set_knob("smooth", -1.0).unwrap();
+    let refused = solve(
+        &Prior::from_bundle(&bundle),
+        &request(&["a person walks"], bad),
+        &wrist_up,
+        &Device::flex(),
+        |_| {},
+    );
+    assert!(matches!(refused, Err(SolveError::Invalid(m)) if m.contains("smooth")));
+}
