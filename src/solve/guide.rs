@@ -497,11 +497,7 @@ fn guide_graph(
         let var = Tensor::<3>::from_data(TensorData::new(full.to_vec(), dims), &ad).require_grad();
         let e = ctx.error.error(ctx.decoder.joints(var.clone(), None));
         check_shape(&e, ctx.samples)?;
-        values = e
-            .clone()
-            .into_data()
-            .try_to_vec::<f32>()
-            .expect("f32 error");
+        values = host(e.clone());
         ensure_finite(&values, "guide", "error", || at(it))?;
         let mut g = if e.is_tracked() {
             var.grad(&e.sum().backward()).map(host)

@@ -19,6 +19,7 @@ use super::bones::SkeletonProjection;
 use super::decode::Decoder;
 use super::feet::FootLock;
 use super::place::Placement;
+use super::run::host;
 use super::{MotionError, SolveError};
 use crate::features::layout::RIC;
 use crate::skeleton::NUM_JOINTS;
@@ -288,11 +289,7 @@ impl<'a> HostObjective<'a> {
             .require_grad();
         let e = self.error.error(j.clone());
         check_shape(&e, self.batch)?;
-        let values = e
-            .clone()
-            .into_data()
-            .try_to_vec::<f32>()
-            .expect("f32 error");
+        let values = host(e.clone());
         let g_world = if e.is_tracked() {
             let grads = e.sum().backward();
             j.grad(&grads)

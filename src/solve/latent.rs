@@ -233,11 +233,7 @@ pub(crate) fn run(
         } else {
             let e = ctx.error.error(ctx.decoder.joints(x.clone(), rt.as_ref()));
             check_shape(&e, ctx.samples)?;
-            let values = e
-                .clone()
-                .into_data()
-                .try_to_vec::<f32>()
-                .expect("f32 error");
+            let values = host(e.clone());
             ensure_finite(&values, "latent", "error", at)?;
             last = host(x.clone().detach());
             (e, values)

@@ -237,11 +237,7 @@ pub(crate) fn run(
                     grads.register(m.x.id, Tensor::<3>::zeros(dims, &ctx.device));
                     return (f64::NAN, grads);
                 }
-                last = e
-                    .clone()
-                    .into_data()
-                    .try_to_vec::<f32>()
-                    .expect("f32 error");
+                last = host(e.clone());
                 let total = e.sum();
                 let value = total.clone().into_scalar::<f64>();
                 if !value.is_finite() {

@@ -124,7 +124,7 @@ impl Ctx<'_> {
 }
 
 /// Host copy of a tensor.
-pub(crate) fn host(t: Tensor<3>) -> Vec<f32> {
+pub(crate) fn host<const D: usize>(t: Tensor<D>) -> Vec<f32> {
     t.into_data().try_to_vec::<f32>().expect("f32 tensor")
 }
 
@@ -298,7 +298,7 @@ fn finish(
     );
     let e = ctx.error.error(joints);
     check_shape(&e, ctx.samples)?;
-    let error = e.into_data().try_to_vec::<f32>().expect("f32 error");
+    let error = host(e);
     ensure_finite(&error, req.solver.name(), "error", || {
         "the returned motions".into()
     })?;

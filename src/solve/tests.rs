@@ -101,15 +101,19 @@ fn pelvis_at_end(j: Tensor<5>) -> Tensor<1> {
     (d.square().sum_dim(4) + 1e-12).sqrt().reshape([b])
 }
 
-/// Left wrist above 1.6 m on every frame: mean hinge in metres.
-fn wrist_up(j: Tensor<5>) -> Tensor<1> {
-    let [b, _, n, _, _] = j.dims();
-    let y = joint(j, 20).narrow(4, 1, 1);
-    (y.neg() + 1.6)
+/// Mean over frames of how far a height `[B, 1, N, 1, 1]` falls short of `target` (m).
+fn mean_shortfall(y: Tensor<5>, target: f32) -> Tensor<1> {
+    let [b, _, n, _, _] = y.dims();
+    (y.neg() + target)
         .clamp_min(0.0)
         .reshape([b, n])
         .mean_dim(1)
         .reshape([b])
+}
+
+/// Left wrist above 1.6 m on every frame: mean hinge in metres.
+fn wrist_up(j: Tensor<5>) -> Tensor<1> {
+    mean_shortfall(joint(j, 20).narrow(4, 1, 1), 1.6)
 }
 
 /// Two people's right wrists within 5 cm at frame 10.
@@ -763,38 +767,36 @@ fn wrist_up_at_8(j: Tensor<5>) -> Tensor<1> {
     wrist_up_on(8, j)
 }
 
+/// Largest frame-to-frame step of `solver`'s edit (guided − unguided wrist height) around
+/// a keyframe at frame 8, relative to the edit at the keyframe; the keyframe must be met.
+fn keyframe_jump(bundle: &ModelBundle, solver: Solver) -> f32 {
+    let wrist_y =
+        |r: &SolveResult| -> Vec<f32> { r.motions[0][0].frames.iter().map(|f| f[20].y).collect() };
+    let solve = |s: Solver| run(bundle, &request(&["a person walks"], s), &wrist_up_at_8);
+    let plain = wrist_y(&solve(solver.unguided()));
+    let r = solve(solver);
+    assert!(r.error[0] < 0.05, "keyframe error {}", r.error[0]);
+    let edit: Vec<f32> = wrist_y(&r).iter().zip(&plain).map(|(a, b)| a - b).collect();
+    let step = (4..12)
+        .map(|t| (edit[t + 1] - edit[t]).abs())
+        .fold(0.0, f32::max);
+    step / edit[8].abs()
+}
+
 #[test]
 fn smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
     let bundle = tiny_bundle();
-    let cfg = |smooth_frames| GuideConfig {
-        steps: 50,
-        smooth_frames,
-        ..GuideConfig::default()
+    let guide = |smooth_frames| {
+        Solver::Guide(GuideConfig {
+            steps: 50,
+            smooth_frames,
+            ..GuideConfig::default()
+        })
     };
-    let wrist_y =
-        |r: &SolveResult| -> Vec<f32> { r.motions[0][0].frames.iter().map(|f| f[20].y).collect() };
-    let plain = wrist_y(&run(
-        &bundle,
-        &request(&["a person walks"], Solver::Guide(cfg(0.0)).unguided()),
-        &wrist_up_at_8,
-    ));
-    // Largest frame-to-frame step of the edit (guided − unguided wrist height) around the
-    // keyframe, relative to the edit at the keyframe.
-    let jump = |smooth: f32| {
-        let r = run(
-            &bundle,
-            &request(&["a person walks"], Solver::Guide(cfg(smooth))),
-            &wrist_up_at_8,
-        );
-        assert!(r.error[0] < 0.05, "σ {smooth}: error {}", r.error[0]);
-        let edit: Vec<f32> = wrist_y(&r).iter().zip(&plain).map(|(a, b)| a - b).collect();
-        let step = (4..12)
-            .map(|t| (edit[t + 1] - edit[t]).abs())
-            .fold(0.0, f32::max);
-        step / edit[8].abs()
-    };
-    let (raw, smooth) = (jump(0.0), jump(3.0));
-    eprintln!("relative jump: raw {raw}, smoothed {smooth}");
+    let (raw, smooth) = (
+        keyframe_jump(&bundle, guide(0.0)),
+        keyframe_jump(&bundle, guide(3.0)),
+    );
     assert!(
         smooth < 0.7 * raw,
         "relative jump: raw {raw}, smoothed {smooth}"
@@ -1110,13 +1112,28 @@ fn a_stiff_statement_does_not_set_the_pace_of_the_others() {
 
 /// Pelvis at least 1.6 m up on every frame: only the root columns (its height) meet it.
 fn pelvis_up(j: Tensor<5>) -> Tensor<1> {
-    let [b, _, n, _, _] = j.dims();
-    let y = joint(j, 0).narrow(4, 1, 1);
-    (y.neg() + 1.6)
-        .clamp_min(0.0)
-        .reshape([b, n])
-        .mean_dim(1)
-        .reshape([b])
+    mean_shortfall(joint(j, 0).narrow(4, 1, 1), 1.6)
+}
+
+/// The first sample's error after solving "a person walks" with `solver`.
+fn walk_error(bundle: &ModelBundle, solver: Solver, err: &dyn MotionError) -> f32 {
+    run(bundle, &request(&["a person walks"], solver), err).error[0]
+}
+
+/// `solver` is refused before it runs, with a message naming `knob`.
+fn assert_refused(bundle: &ModelBundle, solver: Solver, knob: &str) {
+    let refused = solve(
+        &Prior::from_bundle(bundle),
+        &request(&["a person walks"], solver),
+        &wrist_up,
+        &Device::flex(),
+        |_| {},
+    );
+    assert!(
+        matches!(&refused, Err(SolveError::Invalid(m)) if m.contains(knob)),
+        "{knob}: {:?}",
+        refused.err()
+    );
 }
 
 #[test]
@@ -1132,9 +1149,7 @@ fn late_root_scale_leaves_the_path_and_moves_the_pose() {
             ..GuideConfig::default()
         })
     };
-    let error = |s: Solver, err: &dyn MotionError| {
-        run(&bundle, &request(&["a person walks"], s), err).error[0]
-    };
+    let error = |s: Solver, err: &dyn MotionError| walk_error(&bundle, s, err);
     let plain = |err: &dyn MotionError| error(guide(1.0).unguided(), err);
     let (wrist_plain, pelvis_plain) = (plain(&wrist_up), plain(&pelvis_up));
     assert!(
@@ -1159,26 +1174,13 @@ fn late_root_scale_leaves_the_path_and_moves_the_pose() {
     knob.set_knob("late_root", 0.01).unwrap();
     assert!(matches!(&knob, Solver::Guide(c) if c.late_root_scale == 0.01));
     knob.set_knob("late_root", 1.5).unwrap();
-    let refused = solve(
-        &Prior::from_bundle(&bundle),
-        &request(&["a person walks"], knob),
-        &wrist_up,
-        &Device::flex(),
-        |_| {},
-    );
-    assert!(matches!(refused, Err(SolveError::Invalid(m)) if m.contains("late_root")));
+    assert_refused(&bundle, knob, "late_root");
 }
 
 /// Right wrist at least 0.6 m above the head on every frame: only the pose meets it (the
 /// features hold joint heights apart from the root's).
 fn wrist_above_head(j: Tensor<5>) -> Tensor<1> {
-    let [b, _, n, _, _] = j.dims();
-    let rise = (joint(j.clone(), 20) - joint(j, 15)).narrow(4, 1, 1);
-    (rise.neg() + 0.6)
-        .clamp_min(0.0)
-        .reshape([b, n])
-        .mean_dim(1)
-        .reshape([b])
+    mean_shortfall((joint(j.clone(), 20) - joint(j, 15)).narrow(4, 1, 1), 0.6)
 }
 
 #[test]
@@ -1193,9 +1195,7 @@ fn lbfgs_early_root_steps_leave_the_pose_to_the_model() {
             ..LbfgsConfig::default()
         })
     };
-    let error = |s: Solver, err: &dyn MotionError| {
-        run(&bundle, &request(&["a person walks"], s), err).error[0]
-    };
+    let error = |s: Solver, err: &dyn MotionError| walk_error(&bundle, s, err);
     let plain = error(lbfgs(false).unguided(), &wrist_above_head);
     let every = error(lbfgs(false), &wrist_above_head);
     let root = error(lbfgs(true), &wrist_above_head);
@@ -1214,48 +1214,22 @@ fn lbfgs_early_root_steps_leave_the_pose_to_the_model() {
 #[test]
 fn lbfgs_smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
     let bundle = tiny_bundle();
-    let cfg = |smooth_frames| {
+    let lbfgs = |smooth_frames| {
         Solver::Lbfgs(LbfgsConfig {
             steps: 30,
             smooth_frames,
             ..LbfgsConfig::default()
         })
     };
-    let wrist_y =
-        |r: &SolveResult| -> Vec<f32> { r.motions[0][0].frames.iter().map(|f| f[20].y).collect() };
-    let plain = wrist_y(&run(
-        &bundle,
-        &request(&["a person walks"], cfg(0.0).unguided()),
-        &wrist_up_at_8,
-    ));
-    // Largest frame-to-frame step of the edit around the keyframe, relative to the edit
-    // at the keyframe.
-    let jump = |smooth: f32| {
-        let r = run(
-            &bundle,
-            &request(&["a person walks"], cfg(smooth)),
-            &wrist_up_at_8,
-        );
-        assert!(r.error[0] < 0.05, "σ {smooth}: error {}", r.error[0]);
-        let edit: Vec<f32> = wrist_y(&r).iter().zip(&plain).map(|(a, b)| a - b).collect();
-        let step = (4..12)
-            .map(|t| (edit[t + 1] - edit[t]).abs())
-            .fold(0.0, f32::max);
-        step / edit[8].abs()
-    };
-    let (raw, smooth) = (jump(0.0), jump(4.0));
+    let (raw, smooth) = (
+        keyframe_jump(&bundle, lbfgs(0.0)),
+        keyframe_jump(&bundle, lbfgs(4.0)),
+    );
     assert!(
         smooth < 0.7 * raw,
         "relative jump: raw {raw}, smoothed {smooth}"
     );
-    let mut bad = cfg(4.0);
+    let mut bad = lbfgs(4.0);
     bad.set_knob("smooth", -1.0).unwrap();
-    let refused = solve(
-        &Prior::from_bundle(&bundle),
-        &request(&["a person walks"], bad),
-        &wrist_up,
-        &Device::flex(),
-        |_| {},
-    );
-    assert!(matches!(refused, Err(SolveError::Invalid(m)) if m.contains("smooth")));
+    assert_refused(&bundle, bad, "smooth");
 }
