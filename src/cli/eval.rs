@@ -14,6 +14,7 @@ use mprog::model::ModelBundle;
 use mprog::model::sampler::SamplerKind;
 use mprog::model::weights::default_model_dir;
 use mprog::render::{RenderOptions, render_to_path};
+use mprog::solve::cleanup::FootCleanup;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `mprog eval`.
@@ -75,6 +76,10 @@ struct RunArgs {
     /// Write a PNG strip of every generated motion into this folder.
     #[arg(long)]
     render_dir: Option<PathBuf>,
+    /// Clean the feet of the generated motions as `mprog gen` does (default: score the
+    /// model's raw samples).
+    #[arg(long)]
+    foot_cleanup: bool,
 }
 
 /// Options of `mprog eval train-encoder`.
@@ -175,6 +180,7 @@ fn evaluate(args: RunArgs) -> Result<()> {
         batch_size: args.batch,
         min_frames: args.min_frames,
         per_label: args.per_label.then_some(args.per_label_count),
+        foot_cleanup: args.foot_cleanup.then(FootCleanup::default),
     };
     let (report, samples) = run_eval(
         &data,

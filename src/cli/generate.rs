@@ -9,6 +9,7 @@ use mprog::model::ModelBundle;
 use mprog::model::generate::{GenerateError, GenerateRequest, generate_interruptible};
 use mprog::model::sampler::SamplerKind;
 use mprog::model::weights::default_model_dir;
+use mprog::solve::cleanup::{FootCleanup, clean_generated};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -45,6 +46,10 @@ pub struct GenArgs {
     /// Outputs by extension: .bvh .npy .json .gif .png (several allowed).
     #[arg(short, long, num_args = 1.., required = true)]
     out: Vec<PathBuf>,
+    /// Keep the model's samples as they are: no foot cleanup (by default planted feet are
+    /// held in place after sampling, the path unchanged).
+    #[arg(long)]
+    raw: bool,
     #[command(flatten)]
     export: super::export::ExportArgs,
 }
@@ -95,7 +100,7 @@ pub fn run(args: GenArgs) -> Result<()> {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     };
-    let out = match generate_interruptible(&bundle, &req, &device, progress, &interrupt) {
+    let mut out = match generate_interruptible(&bundle, &req, &device, progress, &interrupt) {
         Err(e @ GenerateError::Interrupted { .. }) => {
             bar.finish_and_clear();
             eprintln!("{e}");
@@ -104,6 +109,16 @@ pub fn run(args: GenArgs) -> Result<()> {
         other => other.into_diagnostic()?,
     };
     bar.finish_and_clear();
+    if !args.raw {
+        let report =
+            clean_generated(&mut out, frames, &FootCleanup::default()).into_diagnostic()?;
+        eprintln!(
+            "foot cleanup: {} planted toe-frame pairs, slide {:.1} → {:.1} mm/frame (--raw skips it)",
+            report.planted,
+            report.slide_before * 1000.0,
+            report.slide_after * 1000.0
+        );
+    }
     for line in bundle.vocab.word_report(&args.text) {
         eprintln!("{line}");
     }
@@ -112,6 +127,7 @@ pub fn run(args: GenArgs) -> Result<()> {
     meta.insert("seed".into(), args.seed.into());
     meta.insert("sampler".into(), format!("{sampler:?}").into());
     meta.insert("guidance_scale".into(), (args.guidance as f64).into());
+    meta.insert("foot_cleanup".into(), (!args.raw).into());
     meta.insert(
         "weights_id".into(),
         bundle.manifest.weights_id.clone().into(),

@@ -21,6 +21,7 @@ use crate::model::ModelBundle;
 use crate::model::generate::{GenerateRequest, generate};
 use crate::model::sampler::SamplerKind;
 use crate::motion::Motion;
+use crate::solve::cleanup::{FootCleanup, clean_generated};
 use burn::prelude::*;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
@@ -54,6 +55,8 @@ pub struct EvalSettings {
     pub min_frames: usize,
     /// Motions generated per label for the per-label table; None skips the table.
     pub per_label: Option<usize>,
+    /// Foot cleanup of the generated motions, as `mprog gen` does; None scores them raw.
+    pub foot_cleanup: Option<FootCleanup>,
 }
 
 impl Default for EvalSettings {
@@ -66,6 +69,7 @@ impl Default for EvalSettings {
             batch_size: 16,
             min_frames: 40,
             per_label: None,
+            foot_cleanup: None,
         }
     }
 }
@@ -221,7 +225,10 @@ fn generate_for(
             out.iter().filter(|o| o.is_some()).count(),
             prompts.len()
         ));
-        let generated = generate(bundle, &req, device, |_, _| {})?;
+        let mut generated = generate(bundle, &req, device, |_, _| {})?;
+        if let Some(cfg) = &settings.foot_cleanup {
+            clean_generated(&mut generated, frames, cfg)?;
+        }
         let per = frames * FEATURE_DIM;
         for (k, &i) in chunk.iter().enumerate() {
             let len = prompts[i].frames;

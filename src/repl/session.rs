@@ -19,6 +19,7 @@ use crate::model::sampler::SamplerKind;
 use crate::motion::Motion;
 use crate::render::{RenderOptions, render_to_path};
 use crate::skeleton::FPS;
+use crate::solve::cleanup::{FootCleanup, clean_generated};
 use crate::solve::{Prior, SolveRequest, Solver, solve};
 use burn::tensor::Device;
 use std::path::{Path, PathBuf};
@@ -258,7 +259,11 @@ impl Session {
         let device = self.device.clone();
         let out = match self.bundle() {
             Err(e) => return Reply::error(e),
-            Ok(bundle) => generate(bundle, &req, &device, |_, _| {}),
+            Ok(bundle) => generate(bundle, &req, &device, |_, _| {}).and_then(|mut g| {
+                // As `mprog gen` does by default.
+                clean_generated(&mut g, frames, &FootCleanup::default())?;
+                Ok(g)
+            }),
         };
         match out {
             Err(e) => Reply::error(format!("generation failed: {e}")),

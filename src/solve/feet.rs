@@ -43,8 +43,19 @@ impl FootLock {
     /// Contacts of world joints `[B·P, N, 22, 3]` (flat); `people` motions make one
     /// sample's penalty.
     pub fn new(joints: &[f32], frames: usize, people: usize, weight: f32) -> Self {
+        Self::with_speed(joints, frames, people, weight, PLANTED_SPEED)
+    }
+
+    /// [`new`](Self::new) with toes slower than `planted_speed` (m/s) counted as planted.
+    pub fn with_speed(
+        joints: &[f32],
+        frames: usize,
+        people: usize,
+        weight: f32,
+        planted_speed: f32,
+    ) -> Self {
         let motions = joints.len() / (frames * J3);
-        let limit = PLANTED_SPEED / FPS;
+        let limit = planted_speed / FPS;
         let mut pairs = Vec::new();
         for m in 0..motions {
             for &toe in &SKATING_FEET {

@@ -41,6 +41,7 @@
 
 pub mod adam;
 pub mod bones;
+pub mod cleanup;
 mod decode;
 pub mod feet;
 pub mod guide;
