@@ -89,7 +89,7 @@ pub fn clean_feet(
     let mut joints = vec![0.0; motions * frames * J3];
     projection.forward(&head, &mut projected);
     fk.forward(&projected, frames, &mut joints);
-    let lock = FootLock::with_speed(&joints, frames, 1, 1.0, cfg.planted_speed);
+    let lock = FootLock::with_speed(&joints, frames, 1, 1.0, cfg.planted_speed, 0.0);
     let planted = lock.planted();
     let mean_slide = |penalty: &[f32]| penalty.iter().sum::<f32>() / motions as f32;
     let mut g_joints = vec![0.0; joints.len()];

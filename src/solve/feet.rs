@@ -11,9 +11,15 @@
 //! where the toe is planted: below [`CONTACT_HEIGHT`](super::bones::CONTACT_HEIGHT) on
 //! both frames and sliding slower than [`PLANTED_SPEED`]. A toe that is low but fast is a
 //! swing skimming the floor, not a contact; locking it would stop the step. The penalty
-//! of a sample is the mean horizontal slide over its planted pairs (metres per frame,
-//! smoothed at 0 so it has a gradient everywhere), times a weight:
-//! `w · Σ (√(|Δxz|² + ε²) − ε) / max(1, pairs)`.
+//! of a sample is the mean horizontal slide over its planted pairs beyond a tolerance
+//! (metres per frame, smoothed so it has a gradient everywhere), times a weight:
+//! `w · Σ (√(r² + ε²) − ε) / max(1, pairs)` with `r = max(0, |Δxz| − tol)`.
+//!
+//! The guide's lock tolerates [`LOCK_TOLERANCE`] (5 mm per frame, 0.1 m/s, a fifth of the
+//! skating ratio's threshold): without it every planted pair resisted any slide at all,
+//! and a person standing 0.3 m beside a balance beam could not be moved onto it (GEO-2,
+//! 0.15 m² with the lock against 0.015 without). The foot cleanup of finished motions
+//! ([`super::cleanup`]) tolerates nothing.
 //! The contacts are fixed between set-ups, so the penalty is a smooth function of the
 //! joints.
 
@@ -27,12 +33,17 @@ pub const PLANTED_SPEED: f32 = 1.0;
 /// Smoothing of the slide's norm at zero (metres).
 const EPS: f32 = 1e-3;
 
+/// Slide per frame (metres) a planted toe may make at no cost in the guide's lock.
+pub const LOCK_TOLERANCE: f32 = 0.005;
+
 const J3: usize = NUM_JOINTS * 3;
 
 /// Planted toe contacts of a batch of motions and the slide penalty on them.
 #[derive(Clone, Debug)]
 pub struct FootLock {
     weight: f32,
+    /// Slide per frame that costs nothing (metres).
+    tolerance: f32,
     frames: usize,
     people: usize,
     /// `(motion, toe joint, frame t)`: the toe is planted from `t` to `t + 1`.
@@ -42,17 +53,27 @@ pub struct FootLock {
 impl FootLock {
     /// Contacts of world joints `[B·P, N, 22, 3]` (flat); `people` motions make one
     /// sample's penalty.
+    /// The slide tolerance is [`LOCK_TOLERANCE`].
     pub fn new(joints: &[f32], frames: usize, people: usize, weight: f32) -> Self {
-        Self::with_speed(joints, frames, people, weight, PLANTED_SPEED)
+        Self::with_speed(
+            joints,
+            frames,
+            people,
+            weight,
+            PLANTED_SPEED,
+            LOCK_TOLERANCE,
+        )
     }
 
-    /// [`new`](Self::new) with toes slower than `planted_speed` (m/s) counted as planted.
+    /// [`new`](Self::new) with toes slower than `planted_speed` (m/s) counted as planted and
+    /// slides up to `tolerance` metres per frame free.
     pub fn with_speed(
         joints: &[f32],
         frames: usize,
         people: usize,
         weight: f32,
         planted_speed: f32,
+        tolerance: f32,
     ) -> Self {
         let motions = joints.len() / (frames * J3);
         let limit = planted_speed / FPS;
@@ -73,6 +94,7 @@ impl FootLock {
         }
         FootLock {
             weight,
+            tolerance: tolerance.max(0.0),
             frames,
             people: people.max(1),
             pairs,
@@ -102,9 +124,16 @@ impl FootLock {
                 index(self.frames, m, t + 1, toe),
             );
             let (dx, dz) = (joints[ib] - joints[ia], joints[ib + 2] - joints[ia + 2]);
-            let norm = (dx * dx + dz * dz + EPS * EPS).sqrt();
+            let slide = dx.hypot(dz);
+            let excess = slide - self.tolerance;
+            if excess <= 0.0 || slide == 0.0 {
+                continue;
+            }
+            let norm = (excess * excess + EPS * EPS).sqrt();
             penalty[b] += scale * (norm - EPS);
-            let (gx, gz) = (scale * dx / norm, scale * dz / norm);
+            // d/dΔ of √(r² + ε²) with r = |Δ| − tol: r/√(r² + ε²) · Δ/|Δ|.
+            let along = scale * excess / (norm * slide);
+            let (gx, gz) = (along * dx, along * dz);
             grad[ib] += gx;
             grad[ib + 2] += gz;
             grad[ia] -= gx;
@@ -161,7 +190,7 @@ mod tests {
     #[test]
     fn penalty_is_the_mean_slide_and_its_gradient_matches_finite_differences() {
         let joints = motion(6, |t| [0.01 * t as f32, 0.02, 0.005 * (t * t) as f32]);
-        let lock = FootLock::new(&joints, 6, 1, 2.0);
+        let lock = FootLock::with_speed(&joints, 6, 1, 2.0, PLANTED_SPEED, 0.0);
         let mut g = vec![0.0; joints.len()];
         let p = lock.eval(&joints, &mut g)[0];
         // Both toes slide the same; the mean slide over the pairs, times 2.
@@ -195,7 +224,7 @@ mod tests {
         let still = motion(4, |_| [0.3, 0.0, 0.1]);
         let creep = motion(4, |t| [0.02 * t as f32, 0.0, 0.0]);
         let two = [still.clone(), creep].concat();
-        let lock = FootLock::new(&two, 4, 2, 1.0);
+        let lock = FootLock::with_speed(&two, 4, 2, 1.0, PLANTED_SPEED, 0.0);
         let mut g = vec![0.0; two.len()];
         let p = lock.eval(&two, &mut g);
         assert_eq!(p.len(), 1, "two people, one sample");
@@ -206,5 +235,39 @@ mod tests {
             p[0]
         );
         assert!(g[..still.len()].iter().all(|&v| v == 0.0));
+    }
+
+    #[test]
+    fn slides_within_the_tolerance_are_free_and_the_excess_has_the_right_gradient() {
+        // 3 mm per frame: under the guide's 5 mm tolerance.
+        let drift = motion(6, |t| [0.003 * t as f32, 0.02, 0.0]);
+        let lock = FootLock::new(&drift, 6, 1, 1.0);
+        assert_eq!(lock.planted(), 2 * 5);
+        let mut g = vec![0.0; drift.len()];
+        assert_eq!(lock.eval(&drift, &mut g)[0], 0.0);
+        assert!(g.iter().all(|&v| v == 0.0));
+        // 2 cm per frame: only the 1.5 cm beyond the tolerance costs.
+        let creep = motion(6, |t| [0.02 * t as f32, 0.02, 0.001 * (t * t) as f32]);
+        let lock = FootLock::new(&creep, 6, 1, 1.0);
+        let mut g = vec![0.0; creep.len()];
+        let p = lock.eval(&creep, &mut g)[0];
+        let expected = (0..5)
+            .map(|t| {
+                let r = (0.02f32).hypot(0.001 * (2 * t + 1) as f32) - LOCK_TOLERANCE;
+                r.hypot(EPS) - EPS
+            })
+            .sum::<f32>()
+            / 5.0;
+        assert!((p - expected).abs() < 1e-6, "{p} vs {expected}");
+        let eps = 1e-4;
+        for i in [index(6, 0, 2, 10), index(6, 0, 3, 11) + 2] {
+            let (mut a, mut b) = (creep.clone(), creep.clone());
+            a[i] += eps;
+            b[i] -= eps;
+            let mut scratch = vec![0.0; creep.len()];
+            let fd =
+                (lock.eval(&a, &mut scratch)[0] - lock.eval(&b, &mut scratch)[0]) / (2.0 * eps);
+            assert!((fd - g[i]).abs() < 2e-3, "index {i}: {} vs {fd}", g[i]);
+        }
     }
 }
