@@ -110,7 +110,6 @@ pub fn clean_feet(
         fk.forward(&projected, frames, &mut joints);
         g_joints.fill(0.0);
         let penalty = lock.eval(&joints, &mut g_joints);
-        report.slide_after = mean_slide(&penalty);
         fk.backward(&projected, &g_joints, &mut g_projected);
         projection.backward(&g_projected, &mut g_head);
         // Only the ric block moves: the path, facing and root height stay the model's.

@@ -154,6 +154,7 @@ pub(crate) fn run(
     let mut objective = ctx.host_objective();
     let mut x = ctx.initial_tensor(&ctx.device);
     let mut trace = Vec::with_capacity(n);
+    let early_mask = cfg.early_root_only.then(|| root_mask(&ctx.device));
     for i in (0..n).rev() {
         let x0 = guided_x0(&den, x.clone(), schedule.timesteps[i], &cond);
         let mu = posterior_mean(&schedule, i, x, x0);
@@ -166,14 +167,14 @@ pub(crate) fn run(
         let skeleton = cfg.keep_skeleton && i < cfg.late_steps && k > 0;
         // Root-only steps: the gradient is masked to the root columns, so every L-BFGS
         // direction (built from gradients) and its line search stay in that subspace.
-        let root_only =
-            (cfg.early_root_only && i >= cfg.late_steps).then(|| root_mask(&ctx.device));
-        if skeleton {
-            objective.project_skeleton(&extract_head(&host(mu.clone()), FEATURE_DIM));
+        let root_only = early_mask.as_ref().filter(|_| i >= cfg.late_steps);
+        let mu_head = skeleton.then(|| extract_head(&host(mu.clone()), FEATURE_DIM));
+        if let Some(head) = &mu_head {
+            objective.project_skeleton(head);
         }
         // Smoothed late steps optimise y (from 0) in μ + S·y; `base` holds μ's heads.
         let sigma = cfg.smooth_frames;
-        let base = (skeleton && sigma > 0.0).then(|| extract_head(&host(mu.clone()), FEATURE_DIM));
+        let base = mu_head.filter(|_| sigma > 0.0);
         let mu_before = mu.clone();
         let start = match base {
             Some(_) => mu.zeros_like(),
@@ -253,7 +254,7 @@ pub(crate) fn run(
                 let g = grads
                     .remove::<3>(m.x.id)
                     .unwrap_or_else(|| Tensor::zeros(dims, &ctx.device));
-                let g = match &root_only {
+                let g = match root_only {
                     Some(mask) => g * mask.clone(),
                     None => g,
                 };
