@@ -1,4 +1,4 @@
-//! The training loss's geometric terms (foot contact, velocity) against hand computations
+//! The training loss's extra terms (foot contact, velocity, root columns) against hand computations
 //! on the golden clip.
 
 mod common;
@@ -7,7 +7,7 @@ use burn::prelude::*;
 use common::{golden, mean_std};
 use mprog::features::layout::{CONTACT, RIC};
 use mprog::features::{FEATURE_DIM, recover_from_ric};
-use mprog::model::train::{FootLoss, VelocityLoss};
+use mprog::model::train::{FootLoss, VelocityLoss, root_mse};
 use mprog::skeleton::{FOOT_LEFT, FOOT_RIGHT};
 
 fn normalised(feats: &[f32], mean: &[f32], std: &[f32]) -> Vec<f32> {
@@ -124,4 +124,26 @@ fn velocity_term_counts_jitter_and_ignores_a_constant_offset() {
         "{got} vs {expected}"
     );
     assert!(VelocityLoss::new(0.0, &std, &dev).is_none());
+}
+
+#[test]
+fn root_term_is_the_mse_of_the_four_root_columns_and_ignores_the_rest() {
+    let dev = Device::flex();
+    let (b, n) = (2, 5);
+    let x0: Tensor<3> = Tensor::zeros([b, n, FEATURE_DIM], &dev);
+    // An error of 1 in every non-root column: the root term must not see it.
+    let mut pred = vec![1.0f32; b * n * FEATURE_DIM];
+    // Errors of 0, 1, 2, 3 in the root columns of every frame.
+    for row in pred.chunks_exact_mut(FEATURE_DIM) {
+        row[..4].copy_from_slice(&[0.0, 1.0, 2.0, 3.0]);
+    }
+    let pred: Tensor<3> = Tensor::from_data(TensorData::new(pred, [b, n, FEATURE_DIM]), &dev);
+    // The last two frames of the second clip are padding with a huge error.
+    let mut mask = vec![1.0f32; b * n];
+    mask[2 * n - 2..].fill(0.0);
+    let valid: Tensor<3> = Tensor::from_data(TensorData::new(mask, [b, n, 1]), &dev);
+    let pred = pred.clone() + (Tensor::ones_like(&valid) - valid.clone()) * 100.0;
+    let got = root_mse(pred, x0, valid).into_scalar::<f32>();
+    let expected = (0.0 + 1.0 + 4.0 + 9.0) / 4.0;
+    assert!((got - expected).abs() < 1e-5, "{got} vs {expected}");
 }

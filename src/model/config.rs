@@ -80,6 +80,12 @@ pub struct TrainConfig {
     /// Weight of the velocity loss on the stored joint positions (0 disables).
     #[serde(default)]
     pub velocity_loss: f64,
+    /// Weight of an extra x0 MSE on the 4 root columns (yaw velocity, XZ velocity,
+    /// height), averaged over those columns alone: the base MSE gives each of them 1/263
+    /// of the loss, and a turn is the integral of the yaw velocity over the clip, so a
+    /// small per-frame bias halves it (0 disables).
+    #[serde(default)]
+    pub root_loss: f64,
     /// Probability of dropping each word of a training caption (at least one content word
     /// stays): captions always say "walks forward" or "walks straight ahead", so without it
     /// "a person walks" was a word set the bag-of-words encoder never saw, and stood still.
@@ -105,6 +111,7 @@ impl Default for TrainConfig {
             checkpoint_every: 200,
             foot_loss: 0.0,
             velocity_loss: 0.0,
+            root_loss: 0.0,
             word_drop: 0.0,
             seed: 1,
         }
@@ -172,6 +179,7 @@ impl TrainConfig {
             ("weight_decay", self.weight_decay),
             ("foot_loss", self.foot_loss),
             ("velocity_loss", self.velocity_loss),
+            ("root_loss", self.root_loss),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("`{name}` is {v}; it must be zero or positive"));

@@ -29,7 +29,7 @@ use super::weights::{
     save_bundle_parts,
 };
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
-use crate::features::layout::{CONTACT, RIC, ROOT_Y};
+use crate::features::layout::{CONTACT, RIC, ROOT_Y, ROOT_YAW_VEL};
 use crate::features::recover_from_ric_tensor;
 use crate::fsutil::write_bytes_atomic;
 use crate::interrupt::Interrupt;
@@ -148,6 +148,13 @@ pub fn masked_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1>
     err.sum() / (valid.sum() * f)
 }
 
+/// Masked x0 MSE of the root columns alone (yaw velocity, XZ velocity, height).
+pub fn root_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+    let root = ROOT_YAW_VEL.start..ROOT_Y.end;
+    let cols = |t: Tensor<3>| t.narrow(2, root.start, root.len());
+    masked_mse(cols(pred), cols(x0), valid)
+}
+
 /// Foot-contact loss (MDM's L_foot): the squared per-frame displacement, in cm², of each
 /// foot joint (ankles and toes) of the predicted motion on the frame pairs where the
 /// data's contact label says that joint is planted, averaged over those pairs.
@@ -251,6 +258,8 @@ pub struct GeometricLosses {
     pub foot: Option<FootLoss>,
     /// MDM's velocity term.
     pub velocity: Option<VelocityLoss>,
+    /// Weight of the extra root-column MSE (None when 0).
+    pub root: Option<f32>,
 }
 
 impl GeometricLosses {
@@ -259,6 +268,7 @@ impl GeometricLosses {
         GeometricLosses {
             foot: FootLoss::new(cfg.foot_loss, mean, std, device),
             velocity: VelocityLoss::new(cfg.velocity_loss, std, device),
+            root: (cfg.root_loss > 0.0).then_some(cfg.root_loss as f32),
         }
     }
 }
@@ -282,7 +292,12 @@ fn batch_loss(
                 .mul_scalar(f.weight);
     }
     if let Some(v) = &geometric.velocity {
-        loss = loss + v.term(pred, x0, valid).mul_scalar(v.weight);
+        loss = loss
+            + v.term(pred.clone(), x0.clone(), valid.clone())
+                .mul_scalar(v.weight);
+    }
+    if let Some(w) = geometric.root {
+        loss = loss + root_mse(pred, x0, valid).mul_scalar(w);
     }
     loss
 }

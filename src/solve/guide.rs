@@ -57,14 +57,18 @@
 //! term with a step of its own it held the feet so firmly that the hands could not meet.
 //! A single-statement program steps exactly as before.
 //!
-//! A knob, off by default, preconditions the late steps ([`GuideConfig::late_root_scale`],
-//! `late_root`): it scales the root columns of each step direction. Moving the root moves
-//! every joint of every later frame, so the root's gradient dwarfs the pose's and the step
-//! goes to the path: two people asked to hold hands were walked into each other (pelvises
-//! 0.47 m apart against 0.75 m asked) with their wrists at 0.87 m on every frame, 0.53 m
-//! off. At 0.01 the late steps lift and bend the arms instead (0.0006 m). It is not the
-//! default: on the single-person programs it helped some (HSI-2, GEO-1) and hurt others
-//! (HOI-1, HOD-1, HSI-4), whose late steps still need to move the path.
+//! The late steps are preconditioned ([`GuideConfig::late_root_scale`], `late_root`,
+//! 0.01 by default): the root columns of each step direction are scaled down. Moving the
+//! root moves every joint of every later frame, so the root's gradient dwarfs the pose's
+//! and the step goes to the path: two people asked to hold hands were walked into each
+//! other (pelvises 0.47 m apart against 0.75 m asked) with their wrists at 0.87 m on every
+//! frame, 0.53 m off. Scaled, the late steps lift and bend the arms instead. The early
+//! steps, which steer the path, are not scaled, so a target only the path can reach is
+//! still met (the late steps keep 1 % of the root's share for the last centimetres).
+//! With weights step 6,550 it was made the default (it was 1): at `guide`'s defaults, seed
+//! 1, the dance holding hands 0.18 → 0.015 m and the three-person fight 0.10 → 0.002 m;
+//! in the task benchmark's CPU settings the keyframe error 0.031 → 0.006 m and the PMG
+//! tasks' mean 0.028 → 0.020, at max acceleration 0.167 → 0.199.
 //!
 //! The denoiser is not in the inner loop: only FK, the error and its gradient are, through
 //! the fused host path ([`super::host`]) by default.
@@ -186,7 +190,7 @@ pub struct GuideConfig {
     /// (a diagonal preconditioner, 0..=1; 1: the plain gradient). Moving the root moves
     /// every joint of every later frame, so its gradient dominates: a contact the prompt
     /// does not make is met by walking the people into each other. Small values make the
-    /// late steps meet it with the pose instead (see the module notes).
+    /// late steps meet it with the pose instead (see the module notes). Default 0.01.
     pub late_root_scale: f32,
 }
 
@@ -208,7 +212,7 @@ impl Default for GuideConfig {
             foot_lock: 1.0,
             early_root_only: true,
             split_terms: true,
-            late_root_scale: 1.0,
+            late_root_scale: 0.01,
         }
     }
 }

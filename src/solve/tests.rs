@@ -811,9 +811,14 @@ fn wrist_up_at_start(j: Tensor<5>) -> Tensor<1> {
 fn a_first_frame_target_is_met_unless_the_frame_is_frozen() {
     let bundle = tiny_bundle();
     let solve = |freeze_first_frame| {
+        // The root keeps its full share in the late steps: the tiny untrained model turns
+        // its facing between frames, so a pose-only edit of frame 0 lands 0.25 m away in
+        // frame 1. (The shipped model at the defaults, `late_root=0.01`: HOI-1's wrist
+        // moves 1.4 cm from frame 0 to 1.)
         let cfg = GuideConfig {
             steps: 50,
             freeze_first_frame,
+            late_root_scale: 1.0,
             ..GuideConfig::default()
         };
         run(
