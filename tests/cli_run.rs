@@ -208,3 +208,21 @@ fn gen_says_how_it_read_the_prompt() {
         "{stderr}"
     );
 }
+
+#[test]
+fn eval_refuses_an_unknown_sampler_before_loading_anything() {
+    let out = run(&[
+        "eval",
+        "--data",
+        "/nonexistent",
+        "--sampler",
+        "euler",
+        "--steps",
+        "20",
+    ]);
+    assert!(!out.status.success());
+    let (_, stderr) = text(&out);
+    assert!(stderr.contains("unknown sampler `euler`"), "{stderr}");
+    let out = run(&["eval", "--data", "/nonexistent", "--steps", "0"]);
+    assert!(text(&out).1.contains("--steps ≥ 1"));
+}

@@ -11,7 +11,6 @@ use mprog::eval::{
     train_evaluator,
 };
 use mprog::model::ModelBundle;
-use mprog::model::sampler::SamplerKind;
 use mprog::model::weights::default_model_dir;
 use mprog::render::{RenderOptions, render_to_path};
 use mprog::solve::cleanup::FootCleanup;
@@ -52,9 +51,12 @@ struct RunArgs {
     /// Seed of the clip choice, captions and noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// DDIM steps.
-    #[arg(long, default_value_t = 50)]
-    ddim_steps: usize,
+    /// Sampler: `ddim` (deterministic) or `ddpm` (stochastic, seeded).
+    #[arg(long, default_value = "ddim")]
+    sampler: String,
+    /// Denoising steps (DDIM default 50, DDPM default 1000; fewer are respaced).
+    #[arg(long, alias = "ddim-steps")]
+    steps: Option<usize>,
     /// Classifier-free guidance scale.
     #[arg(long, default_value_t = 2.5)]
     guidance: f32,
@@ -153,6 +155,11 @@ fn train_encoder(args: TrainEncoderArgs) -> Result<()> {
 }
 
 fn evaluate(args: RunArgs) -> Result<()> {
+    // Settings first: a typo fails before minutes of loading.
+    if args.count < 2 || args.batch == 0 || args.steps == Some(0) {
+        return Err(miette!("--count must be ≥ 2, --batch and --steps ≥ 1"));
+    }
+    let sampler = super::generate::sampler_kind(&args.sampler, args.steps)?;
     let data_dir = args.data.ok_or_else(|| miette!("--data is required"))?;
     let device = super::device()?;
     let data = Dataset::load(&data_dir).into_diagnostic()?;
@@ -169,13 +176,10 @@ fn evaluate(args: RunArgs) -> Result<()> {
                 eval_dir.display()
             )
         })?;
-    if args.count < 2 || args.batch == 0 || args.ddim_steps == 0 {
-        return Err(miette!("--count must be ≥ 2, --batch and --ddim-steps ≥ 1"));
-    }
     let settings = EvalSettings {
         count: args.count,
         seed: args.seed,
-        sampler: SamplerKind::Ddim(args.ddim_steps),
+        sampler,
         guidance_scale: args.guidance,
         batch_size: args.batch,
         min_frames: args.min_frames,
