@@ -154,6 +154,14 @@ pub struct HostObjective<'a> {
     feet: Option<FootLock>,
     /// That penalty per sample at the last evaluation (zeros without it).
     penalty: Vec<f32>,
+    /// Rigid XZ transform per motion `[B·P]`, applied in the person's frame before its
+    /// placement (`latent`'s relaxation, [`Self::set_rigid`]).
+    rigid: Option<Vec<Placement>>,
+    /// Joints before the rigid transform (its yaw gradient needs them); only with `rigid`.
+    local: Vec<f32>,
+    /// `∂E/∂(yaw, x, z)` of each motion's rigid transform at the last [`Self::eval`], laid
+    /// out `[yaw × M, x × M, z × M]`.
+    g_rigid: Vec<f32>,
 }
 
 impl<'a> HostObjective<'a> {
@@ -180,7 +188,22 @@ impl<'a> HostObjective<'a> {
             projection: None,
             feet: None,
             penalty: vec![0.0; batch],
+            rigid: None,
+            local: Vec::new(),
+            g_rigid: Vec::new(),
         }
+    }
+
+    /// From now on move each motion `i` by `rigid[i]` in its person's own frame before the
+    /// placement (None: no such move), as [`Decoder::joints`] does with a relaxation.
+    pub fn set_rigid(&mut self, rigid: Option<Vec<Placement>>) {
+        self.rigid = rigid;
+    }
+
+    /// `∂E/∂(yaw, x, z)` of the rigid transforms at the last [`Self::eval`],
+    /// `[yaw × M, x × M, z × M]` (empty without [`Self::set_rigid`]).
+    pub fn rigid_gradient(&self) -> &[f32] {
+        &self.g_rigid
     }
 
     /// From now on add [`FootLock`]'s penalty (weight `weight`) on the feet that are planted
@@ -263,16 +286,16 @@ impl<'a> HostObjective<'a> {
         self.joints.resize(head.len() / HEAD * J3, 0.0);
         self.fk.forward(&self.head, self.frames, &mut self.joints);
         let per = self.frames * NUM_JOINTS;
+        if let Some(rigid) = &self.rigid {
+            self.local.clone_from(&self.joints);
+            for (chunk, r) in self.joints.chunks_exact_mut(per * 3).zip(rigid) {
+                move_xz(chunk, r);
+            }
+        }
         for (i, chunk) in self.joints.chunks_exact_mut(per * 3).enumerate() {
             let q = self.placements[i % self.placements.len()];
-            if q == Placement::IDENTITY {
-                continue;
-            }
-            let (c, s) = q.cos_sin();
-            for p in chunk.chunks_exact_mut(3) {
-                let (x, z) = (p[0], p[2]);
-                p[0] = c * x + s * z + q.x;
-                p[2] = -s * x + c * z + q.z;
+            if q != Placement::IDENTITY {
+                move_xz(chunk, &q);
             }
         }
         &self.joints
@@ -302,13 +325,14 @@ impl<'a> HostObjective<'a> {
             (None, Some(_)) => vec![0.0; self.joints.len()],
             (None, None) => {
                 grad.fill(0.0);
+                self.g_rigid = vec![0.0; 3 * self.rigid.as_ref().map_or(0, Vec::len)];
                 return Ok(values);
             }
         };
         if let Some(lock) = &self.feet {
             self.penalty = lock.eval(&self.joints, &mut g);
         }
-        self.to_head_gradient(&mut g, grad);
+        self.g_rigid = self.to_head_gradient(&mut g, grad);
         Ok(values)
     }
 
@@ -377,9 +401,10 @@ impl<'a> HostObjective<'a> {
     }
 
     /// Gradient with respect to world joints → gradient with respect to the normalised
-    /// heads (overwrites `grad`): undo the placement (Rᵀ), the FK, the projection and the
-    /// de-normalisation.
-    fn to_head_gradient(&self, g: &mut [f32], grad: &mut [f32]) {
+    /// heads (overwrites `grad`): undo the placement (Rᵀ), the rigid transform if set
+    /// (whose own gradient is returned, `[yaw × M, x × M, z × M]`; empty without one), the
+    /// FK, the projection and the de-normalisation.
+    fn to_head_gradient(&self, g: &mut [f32], grad: &mut [f32]) -> Vec<f32> {
         let people = self.placements.len();
         let per = self.frames * NUM_JOINTS * 3;
         for (i, chunk) in g.chunks_exact_mut(per).enumerate() {
@@ -387,11 +412,26 @@ impl<'a> HostObjective<'a> {
             if q == Placement::IDENTITY {
                 continue;
             }
-            let (c, s) = q.cos_sin();
-            for p in chunk.chunks_exact_mut(3) {
-                let (gx, gz) = (p[0], p[2]);
-                p[0] = c * gx - s * gz;
-                p[2] = s * gx + c * gz;
+            rotate_back(chunk, q);
+        }
+        let mut g_rigid = Vec::new();
+        if let Some(rigid) = &self.rigid {
+            let m = rigid.len();
+            g_rigid = vec![0.0; 3 * m];
+            let chunks = g.chunks_exact_mut(per).zip(self.local.chunks_exact(per));
+            for (i, ((gm, local), r)) in chunks.zip(rigid).enumerate() {
+                // x' = c·x + s·z + tx, z' = −s·x + c·z + tz.
+                let (c, s) = r.cos_sin();
+                let (mut gyaw, mut gx, mut gz) = (0.0f64, 0.0f64, 0.0f64);
+                for (gp, p) in gm.chunks_exact(3).zip(local.chunks_exact(3)) {
+                    let (x, z) = (p[0], p[2]);
+                    gyaw += (gp[0] * (-s * x + c * z) + gp[2] * (-c * x - s * z)) as f64;
+                    gx += gp[0] as f64;
+                    gz += gp[2] as f64;
+                }
+                (g_rigid[i], g_rigid[m + i], g_rigid[2 * m + i]) =
+                    (gyaw as f32, gx as f32, gz as f32);
+                rotate_back(gm, *r);
             }
         }
         self.fk.backward(&self.head, g, grad);
@@ -404,6 +444,27 @@ impl<'a> HostObjective<'a> {
                 *v *= s;
             }
         }
+        g_rigid
+    }
+}
+
+/// Moves points `[.., 3]` by `r` in the XZ plane (as [`Placement::apply`]).
+fn move_xz(points: &mut [f32], r: &Placement) {
+    let (c, s) = r.cos_sin();
+    for p in points.chunks_exact_mut(3) {
+        let (x, z) = (p[0], p[2]);
+        p[0] = c * x + s * z + r.x;
+        p[2] = -s * x + c * z + r.z;
+    }
+}
+
+/// Rotates gradients `[.., 3]` back through `q`'s yaw (Rᵀ; the translation has none).
+fn rotate_back(g: &mut [f32], q: Placement) {
+    let (c, s) = q.cos_sin();
+    for p in g.chunks_exact_mut(3) {
+        let (gx, gz) = (p[0], p[2]);
+        p[0] = c * gx - s * gz;
+        p[2] = s * gx + c * gz;
     }
 }
 

@@ -21,8 +21,10 @@
 //! feet kept on the floor ([`super::bones`]), and `P(x̂)` is what is returned. The chain's
 //! own output keeps no skeleton when z is pushed to meet a program: limbs stretched by
 //! 6–18 cm in the cookbook's `latent` runs. The gradient goes through `P` on the fused
-//! host path ([`super::host`]) and enters the chain as `⟨x̂, ∂E/∂x̂⟩`. Not with relaxation,
-//! whose rigid move is differentiated through the burn decoder.
+//! host path ([`super::host`]) and enters the chain as `⟨x̂, ∂E/∂x̂⟩`; with relaxation the
+//! rigid move is applied there too and its gradient computed on the host
+//! ([`HostObjective::set_rigid`](super::host::HostObjective::set_rigid)). Without the
+//! skeleton the rigid move is differentiated through the burn decoder.
 //!
 //! Memory: with [`LatentConfig::checkpoint`] off (the default, as PMG), the graph of the
 //! whole chain (steps × 2 CFG passes) is kept for one backward (measured: 1519 MiB peak RSS
@@ -71,7 +73,7 @@ pub struct LatentConfig {
     /// Re-run each DDIM step during the backward instead of keeping the whole graph.
     pub checkpoint: bool,
     /// Measure and return the chain's output through the skeleton projection (see the
-    /// module notes); ignored with relaxation.
+    /// module notes), with or without relaxation.
     pub keep_skeleton: bool,
 }
 
@@ -178,7 +180,17 @@ pub(crate) fn run(
     let mut last = Vec::new();
     let plain_model = ctx.denoiser();
     let plain_cond = ctx.condition(&ctx.device);
-    let skeleton = cfg.keep_skeleton && !relax;
+    let skeleton = cfg.keep_skeleton;
+    let placements = |rigid: &[f32]| -> Vec<Placement> {
+        (0..m)
+            .map(|i| Placement {
+                yaw: rigid[i],
+                x: rigid[m + i],
+                z: rigid[2 * m + i],
+            })
+            .collect()
+    };
+    let mut g_rigid = Vec::new();
     let mut objective = ctx.host_objective();
     for it in 0..cfg.iterations {
         let at = || format!("iteration {}/{}", it + 1, cfg.iterations);
@@ -197,7 +209,8 @@ pub(crate) fn run(
         } else {
             (ddim_chain(&model, &schedule, zt.clone(), &cond), Vec::new())
         };
-        let rt = relax.then(|| {
+        // With the skeleton the rigid move is differentiated on the host, else in burn.
+        let rt = (relax && !skeleton).then(|| {
             let part = |k: usize| {
                 Tensor::<2>::from_data(
                     TensorData::new(
@@ -219,8 +232,10 @@ pub(crate) fn run(
             let mut full = host(x.clone().detach());
             let mut head = extract_head(&full, FEATURE_DIM);
             objective.project_skeleton(&head);
+            objective.set_rigid(relax.then(|| placements(&rigid)));
             let mut g_head = vec![0.0; head.len()];
             let values = objective.eval(&head, &mut g_head)?;
+            g_rigid = objective.rigid_gradient().to_vec();
             ensure_finite(&values, "latent", "error", at)?;
             objective.apply_projection(&mut head);
             objective.stop_projecting();
@@ -262,27 +277,25 @@ pub(crate) fn run(
         };
         ensure_finite(&gz, "latent", "gradient", at)?;
         adam.step(&mut z, &gz);
-        if let Some(r) = rt {
-            let mut g = Vec::with_capacity(3 * m);
-            for t in [&r.yaw, &r.x, &r.z] {
-                match t.grad(&grads) {
-                    Some(v) => g.extend(v.into_data().try_to_vec::<f32>().expect("f32")),
-                    None => g.extend(std::iter::repeat_n(0.0, m)),
+        if relax {
+            let g = match &rt {
+                Some(r) => {
+                    let mut g = Vec::with_capacity(3 * m);
+                    for t in [&r.yaw, &r.x, &r.z] {
+                        match t.grad(&grads) {
+                            Some(v) => g.extend(v.into_data().try_to_vec::<f32>().expect("f32")),
+                            None => g.extend(std::iter::repeat_n(0.0, m)),
+                        }
+                    }
+                    g
                 }
-            }
+                None => std::mem::take(&mut g_rigid),
+            };
             ensure_finite(&g, "latent", "gradient", at)?;
             adam_rigid.step(&mut rigid, &g);
         }
     }
-    let relax = relax.then(|| {
-        (0..m)
-            .map(|i| Placement {
-                yaw: rigid[i],
-                x: rigid[m + i],
-                z: rigid[2 * m + i],
-            })
-            .collect()
-    });
+    let relax = relax.then(|| placements(&rigid));
     Ok(Outcome {
         x: last,
         relax,

@@ -524,6 +524,90 @@ fn fused_gradient_matches_the_burn_graph() {
 }
 
 #[test]
+fn host_rigid_move_matches_the_burn_graph_and_its_gradient() {
+    // latent's relaxation with the skeleton: the rigid XZ move per motion is applied and
+    // differentiated on the host; the burn decoder is the reference.
+    let (_, decoder, x) = random_case(2, 1);
+    let dev = Device::flex();
+    let weights = NoiseSource::new(5).values(2 * FRAMES * 66);
+    let w = weights.clone();
+    let err = move |j: Tensor<5>| {
+        let wt = Tensor::<1>::from_data(TensorData::new(w.clone(), [w.len()]), &j.device())
+            .reshape([1, 2, FRAMES, 22, 3]);
+        (j.square() * wt)
+            .sum_dim(4)
+            .sum_dim(3)
+            .sum_dim(2)
+            .sum_dim(1)
+            .reshape([1])
+    };
+    let rigid = [(0.3f32, 0.2f32, -0.4f32), (-0.7, -0.1, 0.5)];
+    let mut obj = HostObjective::new(&err, &decoder, 1, FRAMES, &dev);
+    obj.set_rigid(Some(
+        rigid
+            .iter()
+            .map(|&(yaw, x, z)| Placement { yaw, x, z })
+            .collect(),
+    ));
+    let head = extract_head(&x, FEATURE_DIM);
+    let mut g_host = vec![0.0; head.len()];
+    let e_host = obj.eval(&head, &mut g_host).unwrap()[0];
+    let g_rigid_host = obj.rigid_gradient().to_vec();
+
+    let ad = dev.autodiff();
+    let var = Tensor::<3>::from_data(TensorData::new(x.clone(), [2, FRAMES, FEATURE_DIM]), &ad)
+        .require_grad();
+    let part = |k: usize| {
+        let v: Vec<f32> = rigid.iter().map(|r| [r.0, r.1, r.2][k]).collect();
+        Tensor::<2>::from_data(TensorData::new(v, [1, 2]), &ad).require_grad()
+    };
+    let rt = RigidTensors {
+        yaw: part(0),
+        x: part(1),
+        z: part(2),
+    };
+    let e = err(decoder.joints(var.clone(), Some(&rt)));
+    let e_graph = e.clone().into_scalar::<f32>();
+    let grads = e.sum().backward();
+    let g = var
+        .grad(&grads)
+        .unwrap()
+        .into_data()
+        .try_to_vec::<f32>()
+        .unwrap();
+    let g_graph = extract_head(&g, FEATURE_DIM);
+    let mut g_rigid_graph = Vec::new();
+    for t in [&rt.yaw, &rt.x, &rt.z] {
+        g_rigid_graph.extend(
+            t.grad(&grads)
+                .unwrap()
+                .into_data()
+                .try_to_vec::<f32>()
+                .unwrap(),
+        );
+    }
+    assert!(
+        (e_host - e_graph).abs() < 1e-4 * e_graph.abs().max(1.0),
+        "{e_host} vs {e_graph}"
+    );
+    let close = |a: &[f32], b: &[f32], what: &str| {
+        let scale = b.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        let worst = a
+            .iter()
+            .zip(b)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f32::max);
+        assert_eq!(a.len(), b.len(), "{what}");
+        assert!(
+            scale > 1e-3 && worst < 1e-3 * scale,
+            "{what}: differ by {worst} (scale {scale})"
+        );
+    };
+    close(&g_host, &g_graph, "head gradient");
+    close(&g_rigid_host, &g_rigid_graph, "rigid gradient");
+}
+
+#[test]
 fn host_fk_backward_matches_finite_differences() {
     let frames = 6;
     let mut head: Vec<f32> = NoiseSource::new(8)
