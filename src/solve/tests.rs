@@ -474,14 +474,11 @@ fn fused_host_fk_matches_the_burn_graph() {
     assert!(worst < 1e-4, "joints differ by {worst}");
 }
 
-#[test]
-fn fused_gradient_matches_the_burn_graph() {
-    let (_, decoder, x) = random_case(2, 1);
-    let dev = Device::flex();
-    // A non-trivial error: weighted squares of all coordinates, summed per sample.
-    let weights = NoiseSource::new(4).values(2 * FRAMES * 66);
-    let w = weights.clone();
-    let err = move |j: Tensor<5>| {
+/// A non-trivial error for one sample of two people: weighted squares of all coordinates
+/// (weights seeded), summed.
+fn weighted_squares(seed: u64) -> impl Fn(Tensor<5>) -> Tensor<1> {
+    let w = NoiseSource::new(seed).values(2 * FRAMES * 66);
+    move |j: Tensor<5>| {
         let wt = Tensor::<1>::from_data(TensorData::new(w.clone(), [w.len()]), &j.device())
             .reshape([1, 2, FRAMES, 22, 3]);
         (j.square() * wt)
@@ -490,7 +487,14 @@ fn fused_gradient_matches_the_burn_graph() {
             .sum_dim(2)
             .sum_dim(1)
             .reshape([1])
-    };
+    }
+}
+
+#[test]
+fn fused_gradient_matches_the_burn_graph() {
+    let (_, decoder, x) = random_case(2, 1);
+    let dev = Device::flex();
+    let err = weighted_squares(4);
     let mut obj = HostObjective::new(&err, &decoder, 1, FRAMES, &dev);
     let head = extract_head(&x, FEATURE_DIM);
     let mut g_host = vec![0.0; head.len()];
@@ -529,18 +533,7 @@ fn host_rigid_move_matches_the_burn_graph_and_its_gradient() {
     // differentiated on the host; the burn decoder is the reference.
     let (_, decoder, x) = random_case(2, 1);
     let dev = Device::flex();
-    let weights = NoiseSource::new(5).values(2 * FRAMES * 66);
-    let w = weights.clone();
-    let err = move |j: Tensor<5>| {
-        let wt = Tensor::<1>::from_data(TensorData::new(w.clone(), [w.len()]), &j.device())
-            .reshape([1, 2, FRAMES, 22, 3]);
-        (j.square() * wt)
-            .sum_dim(4)
-            .sum_dim(3)
-            .sum_dim(2)
-            .sum_dim(1)
-            .reshape([1])
-    };
+    let err = weighted_squares(5);
     let rigid = [(0.3f32, 0.2f32, -0.4f32), (-0.7, -0.1, 0.5)];
     let mut obj = HostObjective::new(&err, &decoder, 1, FRAMES, &dev);
     obj.set_rigid(Some(
