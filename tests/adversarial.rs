@@ -171,6 +171,7 @@ fn tiny_config() -> ModelConfig {
         dropout: 0.0,
         d_text: 8,
         max_frames: 40,
+        input_skip: false,
     }
 }
 

@@ -41,6 +41,7 @@ fn model_config(d_model: usize, layers: usize) -> ModelConfig {
         dropout: 0.1,
         d_text: 8,
         max_frames: 40,
+        input_skip: false,
     }
 }
 
@@ -289,6 +290,7 @@ fn generation_stops_on_ctrl_c_and_writes_nothing() {
         &d.join("model"),
         ModelConfig {
             max_frames: 196,
+            input_skip: false,
             ..model_config(64, 2)
         },
     );

@@ -252,6 +252,7 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
         d_ff: 64,
         d_text: 8,
         max_frames: 50,
+        input_skip: false,
         ..ModelConfig::default()
     };
     let vocab = Vocabulary::from_captions(

@@ -24,6 +24,16 @@ pub struct ModelConfig {
     pub d_text: usize,
     /// Longest motion the model is asked for (frames).
     pub max_frames: usize,
+    /// Add a learned, timestep-gated copy of the input to the output (`x̂0 = F(x_t) +
+    /// g(t) ⊙ x_t`, g zero at initialisation): at small t the sample is nearly its own
+    /// answer, and a network squeezing 263 features through its width copies the small
+    /// columns (the root's yaw rate) badly. Bundles without it load as before.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub input_skip: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 fn default_features() -> usize {
@@ -44,6 +54,7 @@ impl Default for ModelConfig {
             dropout: 0.1,
             d_text: 128,
             max_frames: 196,
+            input_skip: false,
         }
     }
 }

@@ -45,8 +45,17 @@ pub struct Mdm {
     text_proj: Linear,
     encoder: TransformerEncoder,
     output_proj: Linear,
+    /// Timestep sinusoid → per-feature gain on x_t added to the output (`input_skip`).
+    skip: Option<Linear>,
     dropout: Dropout,
     d_model: usize,
+}
+
+/// A `d → features` linear layer that starts at zero (weights and bias).
+fn zero_skip(d: usize, features: usize, device: &Device) -> Linear {
+    LinearConfig::new(d, features)
+        .with_initializer(burn::nn::Initializer::Zeros)
+        .init(device)
 }
 
 /// Sinusoidal table rows for the given positions: `[len(positions), d]`.
@@ -78,9 +87,30 @@ impl Mdm {
                 .with_dropout(config.dropout)
                 .init(device),
             output_proj: LinearConfig::new(d, config.features).init(device),
+            skip: config
+                .input_skip
+                .then(|| zero_skip(d, config.features, device)),
             dropout: DropoutConfig::new(config.dropout).init(),
             d_model: d,
         }
+    }
+
+    /// This denoiser with a zero input skip added (no change to what it predicts), so a
+    /// model trained without `input_skip` can continue training with it.
+    pub fn with_input_skip(mut self, device: &Device) -> Self {
+        if self.skip.is_none() {
+            let features = self.output_proj.weight.dims()[1];
+            self.skip = Some(zero_skip(self.d_model, features, device));
+        }
+        self
+    }
+
+    /// The input skip's per-feature gain at timestep `t` (None without `input_skip`).
+    pub fn input_skip_gain(&self, t: usize) -> Option<Vec<f32>> {
+        let skip = self.skip.as_ref()?;
+        let device = skip.weight.device();
+        let gain = skip.forward(sinusoids(std::iter::once(t), self.d_model, &device));
+        Some(gain.into_data().try_into_vec::<f32>().expect("f32 tensor"))
     }
 
     /// `[B, d]` condition token: timestep embedding plus (possibly dropped) text.
@@ -109,7 +139,14 @@ impl Denoiser for Mdm {
             enc_in = enc_in.mask_pad(Tensor::cat(vec![cond_col, pad.clone()], 1));
         }
         let out = self.encoder.forward(enc_in); // [B, N+1, d]
-        let out = out.narrow(1, 1, n);
-        self.output_proj.forward(out) // [B, N, F]
+        let out = self.output_proj.forward(out.narrow(1, 1, n)); // [B, N, F]
+        match &self.skip {
+            Some(skip) => {
+                let t = sinusoids(input.timesteps.iter().copied(), self.d_model, &device);
+                let gain = skip.forward(t).unsqueeze_dim::<3>(1); // [B, 1, F]
+                out + gain * input.x_t.clone()
+            }
+            None => out,
+        }
     }
 }

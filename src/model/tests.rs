@@ -22,6 +22,7 @@ fn tiny() -> ModelConfig {
         dropout: 0.1,
         d_text: 8,
         max_frames: 40,
+        input_skip: false,
     }
 }
 
@@ -292,4 +293,60 @@ fn a_new_run_can_start_from_a_bundle() {
     .run(&|_, _, _| {})
     .unwrap_err();
     assert!(err.to_string().contains("does not match"), "{err}");
+}
+
+#[test]
+fn a_run_with_input_skip_can_start_from_a_bundle_without_it() {
+    let data = synthetic_dataset();
+    let first = tempfile::tempdir().unwrap();
+    let config = TrainConfig {
+        model: tiny(),
+        batch_size: 4,
+        crop_frames: 16,
+        warmup_steps: 1,
+        checkpoint_every: 5,
+        steps: 100,
+        learning_rate: 1e-2,
+        ..TrainConfig::default()
+    };
+    let run = |out: &std::path::Path, config: &TrainConfig, init, steps| TrainRun {
+        data: &data,
+        config: config.clone(),
+        out: out.to_path_buf(),
+        max_steps_now: Some(steps),
+        interrupt: Default::default(),
+        init_from: init,
+        device: Device::flex(),
+    };
+    run(first.path(), &config, None, 5)
+        .run(&|_, _, _| {})
+        .unwrap();
+    let dev = Device::flex();
+    let plain = super::weights::ModelBundle::load(&first.path().join("bundle"), &dev).unwrap();
+    assert_eq!(plain.model.input_skip_gain(10), None);
+    // Adding the skip changes nothing until it is trained.
+    let inp = input(2, 8, &dev);
+    let with = plain.model.clone().with_input_skip(&dev);
+    let diff = (plain.model.predict_x0(&inp) - with.predict_x0(&inp))
+        .abs()
+        .max()
+        .into_scalar::<f32>();
+    assert_eq!(diff, 0.0);
+    let mut skip = config.clone();
+    skip.model.input_skip = true;
+    let second = tempfile::tempdir().unwrap();
+    let state = run(second.path(), &skip, Some(first.path().join("bundle")), 5)
+        .run(&|_, _, _| {})
+        .unwrap();
+    assert_eq!(state.step, 10);
+    let trained = super::weights::ModelBundle::load(&second.path().join("bundle"), &dev).unwrap();
+    assert!(trained.config.input_skip);
+    let gain = trained.model.input_skip_gain(10).unwrap();
+    assert_eq!(gain.len(), FEATURE_DIM);
+    assert!(gain.iter().any(|g| *g != 0.0), "the skip learned nothing");
+    // ... and it resumes.
+    let state = run(second.path(), &skip, None, 5)
+        .run(&|_, _, _| {})
+        .unwrap();
+    assert_eq!(state.step, 15);
 }

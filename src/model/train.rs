@@ -18,7 +18,7 @@
 //! kill at any moment leaves either the old or the new checkpoint complete.
 
 use super::batch::{HostBatch, draw_batch};
-use super::config::TrainConfig;
+use super::config::{ModelConfig, TrainConfig};
 use super::denoiser::{Denoiser, DenoiserInput, Mdm};
 use super::ema::ema_update;
 use super::noise::NoiseSource;
@@ -364,7 +364,13 @@ impl TrainRun<'_> {
         let Some(dir) = self.existing_checkpoint() else {
             if let Some(init) = &self.init_from {
                 let bundle = ModelBundle::load(init, plain).map_err(|e| file_err(init, e))?;
-                if bundle.config != cfg.model || bundle.vocab != *vocab {
+                // A bundle without the input skip may start a run with it (added at zero).
+                let add_skip = cfg.model.input_skip && !bundle.config.input_skip;
+                let as_run = ModelConfig {
+                    input_skip: cfg.model.input_skip,
+                    ..bundle.config.clone()
+                };
+                if as_run != cfg.model || bundle.vocab != *vocab {
                     return Err(TrainError::Invalid(format!(
                         "{} does not match this run: its model config or vocabulary differs from the training config's",
                         init.display()
@@ -373,12 +379,18 @@ impl TrainRun<'_> {
                 // Load into a fresh training module so its parameters track gradients.
                 let weights = init.join("model.safetensors");
                 let bytes = std::fs::read(&weights).map_err(|e| file_err(&weights, e))?;
-                let fresh = Mdm::new(&cfg.model, vocab.len(), train_dev);
-                let model = model_from_safetensors(fresh, bytes, bundle.manifest.half_precision)
-                    .map_err(|e| file_err(&weights, e))?;
+                let fresh = Mdm::new(&bundle.config, vocab.len(), train_dev);
+                let mut model =
+                    model_from_safetensors(fresh, bytes, bundle.manifest.half_precision)
+                        .map_err(|e| file_err(&weights, e))?;
+                let mut ema = bundle.model;
+                if add_skip {
+                    model = model.with_input_skip(train_dev);
+                    ema = ema.with_input_skip(plain);
+                }
                 return Ok(Checkpoint {
                     model,
-                    ema: bundle.model,
+                    ema,
                     optim: new_optimizer(cfg),
                     state: TrainState {
                         step: bundle.manifest.steps,

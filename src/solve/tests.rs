@@ -62,6 +62,7 @@ fn tiny_bundle() -> ModelBundle {
         dropout: 0.1,
         d_text: 8,
         max_frames: 40,
+        input_skip: false,
     };
     let vocab = Vocabulary::from_captions(["a person walks forward", "a person waves"], 8);
     let model =
