@@ -994,6 +994,20 @@ fn bundle_config_of_another_shape() {
 }
 
 #[test]
+fn bundle_config_asking_for_an_input_skip_the_weights_lack() {
+    let dir = tempfile::tempdir().unwrap();
+    tiny_bundle(dir.path());
+    let p = dir.path().join("config.toml");
+    let mut text = std::fs::read_to_string(&p).unwrap();
+    text.push_str("input_skip = true\n");
+    std::fs::write(&p, text).unwrap();
+    assert_mentions(
+        &load_error(dir.path()),
+        &["model.safetensors", "do not fit", "missing"],
+    );
+}
+
+#[test]
 fn bundle_config_with_unknown_field() {
     let dir = tempfile::tempdir().unwrap();
     tiny_bundle(dir.path());
