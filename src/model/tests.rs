@@ -349,4 +349,10 @@ fn a_run_with_input_skip_can_start_from_a_bundle_without_it() {
         .run(&|_, _, _| {})
         .unwrap();
     assert_eq!(state.step, 15);
+    // A learned skip is not dropped by starting a run without it.
+    let third = tempfile::tempdir().unwrap();
+    let err = run(third.path(), &config, Some(second.path().join("bundle")), 1)
+        .run(&|_, _, _| {})
+        .unwrap_err();
+    assert!(err.to_string().contains("does not match"), "{err}");
 }

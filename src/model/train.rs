@@ -364,10 +364,11 @@ impl TrainRun<'_> {
         let Some(dir) = self.existing_checkpoint() else {
             if let Some(init) = &self.init_from {
                 let bundle = ModelBundle::load(init, plain).map_err(|e| file_err(init, e))?;
-                // A bundle without the input skip may start a run with it (added at zero).
+                // A bundle without the input skip may start a run with it (added at zero);
+                // one with a learned skip cannot start a run without it.
                 let add_skip = cfg.model.input_skip && !bundle.config.input_skip;
                 let as_run = ModelConfig {
-                    input_skip: cfg.model.input_skip,
+                    input_skip: bundle.config.input_skip || cfg.model.input_skip,
                     ..bundle.config.clone()
                 };
                 if as_run != cfg.model || bundle.vocab != *vocab {
