@@ -254,11 +254,9 @@ fn interrupted_training_saves_a_checkpoint_and_resumes() {
     assert_eq!(csv.lines().count(), 1 + 12);
 }
 
-#[test]
-fn a_new_run_can_start_from_a_bundle() {
-    let data = synthetic_dataset();
-    let first = tempfile::tempdir().unwrap();
-    let config = TrainConfig {
+/// Short runs of the tiny model that checkpoint every 5 steps.
+fn tiny_run_config() -> TrainConfig {
+    TrainConfig {
         model: tiny(),
         batch_size: 4,
         crop_frames: 16,
@@ -266,7 +264,14 @@ fn a_new_run_can_start_from_a_bundle() {
         checkpoint_every: 5,
         steps: 100,
         ..TrainConfig::default()
-    };
+    }
+}
+
+#[test]
+fn a_new_run_can_start_from_a_bundle() {
+    let data = synthetic_dataset();
+    let first = tempfile::tempdir().unwrap();
+    let config = tiny_run_config();
     let run = |out: &std::path::Path, init: Option<std::path::PathBuf>, steps| TrainRun {
         data: &data,
         config: config.clone(),
@@ -300,14 +305,8 @@ fn a_run_with_input_skip_can_start_from_a_bundle_without_it() {
     let data = synthetic_dataset();
     let first = tempfile::tempdir().unwrap();
     let config = TrainConfig {
-        model: tiny(),
-        batch_size: 4,
-        crop_frames: 16,
-        warmup_steps: 1,
-        checkpoint_every: 5,
-        steps: 100,
         learning_rate: 1e-2,
-        ..TrainConfig::default()
+        ..tiny_run_config()
     };
     let run = |out: &std::path::Path, config: &TrainConfig, init, steps| TrainRun {
         data: &data,
