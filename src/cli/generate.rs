@@ -3,6 +3,8 @@
 use super::io::{check_outputs, numbered, write_outputs_with};
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr};
+use mprog::eval::metrics::MotionMetrics;
+use mprog::eval::table::motions_markdown;
 use mprog::formats::Meta;
 use mprog::interrupt::Interrupt;
 use mprog::model::ModelBundle;
@@ -150,6 +152,8 @@ pub fn run(args: GenArgs) -> Result<()> {
             &args.export,
         )?;
     }
+    let metrics: Vec<MotionMetrics> = out.motions.iter().map(MotionMetrics::of).collect();
+    eprint!("{}", motions_markdown(&metrics));
     eprintln!(
         "generated {count} motion(s) of {frames} frames in {:.1} s (weights {})",
         started.elapsed().as_secs_f64(),

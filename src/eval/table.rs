@@ -132,3 +132,77 @@ pub fn labels_markdown(r: &EvalReport) -> String {
     );
     out
 }
+
+/// One row per motion of what `mprog gen` made (speed, turn, hands, feet, acceleration),
+/// and a mean ± standard deviation row when there are several: enough to see at a glance
+/// whether a batch walks, turns or raises its hands as asked.
+pub fn motions_markdown(metrics: &[super::metrics::MotionMetrics]) -> String {
+    let mut out = String::from(
+        "| motion | speed m/s | total turn (deg) | wrists above head (m) | foot skating | \
+         max accel (m/frame²) |\n| --- | --- | --- | --- | --- | --- |\n",
+    );
+    let columns = |m: &super::metrics::MotionMetrics| {
+        [
+            m.speed,
+            m.turn_deg,
+            m.wrists_above_head,
+            m.skating,
+            m.max_accel,
+        ]
+    };
+    let fmt = |v: [f32; 5]| {
+        format!(
+            "{:.2} | {:+.0} | {:+.2} | {:.3} | {:.3}",
+            v[0], v[1], v[2], v[3], v[4]
+        )
+    };
+    for (i, m) in metrics.iter().enumerate() {
+        let _ = writeln!(out, "| {i} | {} |", fmt(columns(m)));
+    }
+    if metrics.len() > 1 {
+        let n = metrics.len() as f32;
+        let rows: Vec<[f32; 5]> = metrics.iter().map(columns).collect();
+        let mean: [f32; 5] = std::array::from_fn(|c| rows.iter().map(|r| r[c]).sum::<f32>() / n);
+        let sd: [f32; 5] = std::array::from_fn(|c| {
+            (rows.iter().map(|r| (r[c] - mean[c]).powi(2)).sum::<f32>() / (n - 1.0)).sqrt()
+        });
+        let _ = writeln!(
+            out,
+            "| mean ± sd | {:.2} ± {:.2} | {:+.0} ± {:.0} | {:+.2} ± {:.2} | {:.3} ± {:.3} | {:.3} ± {:.3} |",
+            mean[0], sd[0], mean[1], sd[1], mean[2], sd[2], mean[3], sd[3], mean[4], sd[4]
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::metrics::MotionMetrics;
+
+    fn turning(turn_deg: f32) -> MotionMetrics {
+        MotionMetrics {
+            speed: 1.0,
+            turn_deg,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn one_motion_has_no_summary_row() {
+        let table = motions_markdown(&[turning(90.0)]);
+        assert!(table.contains("| 0 | 1.00 | +90 |"), "{table}");
+        assert!(!table.contains("mean"), "{table}");
+    }
+
+    #[test]
+    fn several_motions_get_mean_and_sample_sd() {
+        let table = motions_markdown(&[turning(80.0), turning(100.0), turning(-60.0)]);
+        // mean +40, sample sd sqrt((1600 + 3600 + 10000) / 2) = 87.2
+        assert!(
+            table.contains("| mean ± sd | 1.00 ± 0.00 | +40 ± 87 |"),
+            "{table}"
+        );
+        assert_eq!(table.lines().count(), 2 + 3 + 1, "{table}");
+    }
+}
