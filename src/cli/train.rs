@@ -107,17 +107,24 @@ pub fn run(args: TrainArgs) -> Result<()> {
         init_from: args.init_from.clone(),
         device: super::device()?,
     };
+    // The log's s/step is wall time over the last logged steps (checkpoints included), not
+    // the run's lifetime mean, which carries every earlier session's speed.
+    let last_log = std::cell::Cell::new(None::<(usize, std::time::Instant)>);
     let state = run
         .run(&|state, loss, lr| {
             bar.set_position(state.step as u64);
             bar.set_message(format!("loss {loss:.4}  lr {lr:.1e}"));
             // Without a terminal (a background run) the bar is hidden: log a line instead.
             if !std::io::stderr().is_terminal() && state.step % 25 == 0 {
-                eprintln!(
-                    "step {} loss {loss:.4} lr {lr:.1e} {:.2} s/step",
-                    state.step,
-                    state.seconds / state.step.max(1) as f64
-                );
+                let now = std::time::Instant::now();
+                let rate = match last_log.replace(Some((state.step, now))) {
+                    Some((step, at)) if state.step > step => format!(
+                        "{:.2} s/step",
+                        (now - at).as_secs_f64() / (state.step - step) as f64
+                    ),
+                    _ => "first logged step".to_string(),
+                };
+                eprintln!("step {} loss {loss:.4} lr {lr:.1e} {rate}", state.step);
             }
         })
         .into_diagnostic()?;
