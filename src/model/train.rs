@@ -56,6 +56,10 @@ pub struct TrainState {
     pub recent_loss: f64,
     /// Validation loss of the EMA weights at the last checkpoint.
     pub val_loss: Option<f64>,
+    /// Step at which this run's optimizer started (a run begun `--init-from` a bundle
+    /// restarts AdamW at the bundle's step); the warm-up counts from here.
+    #[serde(default)]
+    pub optimizer_started_at: usize,
 }
 
 /// Errors of a training run.
@@ -329,8 +333,12 @@ struct Checkpoint {
     state: TrainState,
 }
 
-fn learning_rate(cfg: &TrainConfig, step: usize) -> f64 {
-    cfg.learning_rate * ((step + 1) as f64 / cfg.warmup_steps.max(1) as f64).min(1.0)
+/// Linear warm-up over the first `warmup_steps` of the optimizer's life: a restarted
+/// AdamW's first updates are ±lr on every weight (its moment estimates are one gradient
+/// old), which at full rate shakes a trained model.
+fn learning_rate(cfg: &TrainConfig, state: &TrainState) -> f64 {
+    let since_start = state.step.saturating_sub(state.optimizer_started_at);
+    cfg.learning_rate * ((since_start + 1) as f64 / cfg.warmup_steps.max(1) as f64).min(1.0)
 }
 
 fn new_optimizer(cfg: &TrainConfig) -> ModuleOptimizer {
@@ -396,6 +404,7 @@ impl TrainRun<'_> {
                     state: TrainState {
                         step: bundle.manifest.steps,
                         seconds: bundle.manifest.train_seconds,
+                        optimizer_started_at: bundle.manifest.steps,
                         ..TrainState::default()
                     },
                 });
@@ -601,7 +610,7 @@ impl TrainRun<'_> {
                 return Err(TrainError::Diverged { step, loss: value });
             }
             let grads = GradientsParams::from_grads(loss.backward(), &ck.model);
-            let lr = learning_rate(cfg, step);
+            let lr = learning_rate(cfg, &ck.state);
             ck.model = ck.optim.step(lr, ck.model, grads);
             let decay = (cfg.ema_decay as f32).min((1 + step) as f32 / (10 + step) as f32);
             ck.ema = ema_update(ck.ema, &ck.model.valid(), decay);
@@ -739,4 +748,35 @@ fn append(path: &Path, header: &str, rows: &str) -> Result<(), TrainError> {
             .map_err(|e| file_err(path, e))?;
     }
     f.write_all(rows.as_bytes()).map_err(|e| file_err(path, e))
+}
+
+#[cfg(test)]
+mod warmup_tests {
+    use super::*;
+
+    #[test]
+    fn warm_up_restarts_with_the_optimizer() {
+        let cfg = TrainConfig {
+            learning_rate: 3e-4,
+            warmup_steps: 300,
+            ..TrainConfig::default()
+        };
+        let at = |step, optimizer_started_at| {
+            learning_rate(
+                &cfg,
+                &TrainState {
+                    step,
+                    optimizer_started_at,
+                    ..TrainState::default()
+                },
+            )
+        };
+        // A fresh run warms up from step 0.
+        assert!((at(0, 0) - 1e-6).abs() < 1e-12);
+        assert!((at(299, 0) - 3e-4).abs() < 1e-12);
+        // A run begun from a step-6,550 bundle warms up again, not at full rate.
+        assert!((at(6_550, 6_550) - 1e-6).abs() < 1e-12);
+        assert!((at(6_700, 6_550) - 1.51e-4).abs() < 1e-12);
+        assert!((at(6_900, 6_550) - 3e-4).abs() < 1e-12);
+    }
 }
