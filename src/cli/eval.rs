@@ -82,6 +82,9 @@ struct RunArgs {
     /// model's raw samples).
     #[arg(long)]
     foot_cleanup: bool,
+    /// Average the denoiser with its left/right mirror, as `mprog gen --mirror-average`.
+    #[arg(long)]
+    mirror_average: bool,
 }
 
 /// Options of `mprog eval train-encoder`.
@@ -185,6 +188,7 @@ fn evaluate(args: RunArgs) -> Result<()> {
         min_frames: args.min_frames,
         per_label: args.per_label.then_some(args.per_label_count),
         foot_cleanup: args.foot_cleanup.then(FootCleanup::default),
+        mirror_average: args.mirror_average,
     };
     let (report, samples) = run_eval(
         &data,

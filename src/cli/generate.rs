@@ -42,6 +42,10 @@ pub struct GenArgs {
     /// Classifier-free guidance scale.
     #[arg(long, default_value_t = 2.5)]
     guidance: f32,
+    /// Average every denoising step with its left/right mirror (swapped sides in the
+    /// motion and the prompt): left and right turns become exact mirrors; twice the work.
+    #[arg(long)]
+    mirror_average: bool,
     /// Model bundle folder (default: models/default).
     #[arg(long)]
     model: Option<PathBuf>,
@@ -88,6 +92,7 @@ pub fn run(args: GenArgs) -> Result<()> {
         seed: args.seed,
         sampler,
         guidance_scale: args.guidance,
+        mirror_average: args.mirror_average,
     };
     let bar = ProgressBar::new(0);
     bar.set_style(

@@ -57,6 +57,8 @@ pub struct EvalSettings {
     pub per_label: Option<usize>,
     /// Foot cleanup of the generated motions, as `mprog gen` does; None scores them raw.
     pub foot_cleanup: Option<FootCleanup>,
+    /// Average the denoiser with its left/right mirror (`GenerateRequest::mirror_average`).
+    pub mirror_average: bool,
 }
 
 impl Default for EvalSettings {
@@ -70,6 +72,7 @@ impl Default for EvalSettings {
             min_frames: 40,
             per_label: None,
             foot_cleanup: None,
+            mirror_average: false,
         }
     }
 }
@@ -218,6 +221,7 @@ fn generate_for(
             seed: seed.wrapping_add(b as u64),
             sampler: settings.sampler,
             guidance_scale: settings.guidance_scale,
+            mirror_average: settings.mirror_average,
         };
         log(&format!(
             "generating {} motions of {frames} frames ({}/{} done)",

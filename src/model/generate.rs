@@ -1,6 +1,7 @@
 //! Text-to-motion generation with a model bundle: seeded noise → sampler chain →
 //! de-normalised features → joints. Batched over `count` samples.
 
+use super::mirror::MirrorAveraged;
 use super::noise::NoiseSource;
 use super::sampler::{Condition, SamplerKind, sample_chain_until, schedule_for};
 use super::schedule::{DIFFUSION_STEPS, NoiseSchedule};
@@ -23,6 +24,9 @@ pub struct GenerateRequest {
     pub sampler: SamplerKind,
     /// Classifier-free guidance scale.
     pub guidance_scale: f32,
+    /// Average each x̂0 with its left/right mirror ([`MirrorAveraged`]): exactly
+    /// symmetric turns and sides at twice the batch.
+    pub mirror_average: bool,
 }
 
 /// Generated motions.
@@ -113,19 +117,35 @@ pub fn generate_interruptible(
     let mut noise = NoiseSource::new(req.seed ^ 0x5DEE_CE66);
     let total = schedule.len();
     let mut done = 0;
-    let x0 = sample_chain_until(
-        &model,
-        &schedule,
-        req.sampler,
-        x_t,
-        &cond,
-        &mut noise,
-        |d, t| {
-            done = d;
-            on_step(d, t);
-        },
-        &|| interrupt.is_requested(),
-    )
+    let on_step = |d, t| {
+        done = d;
+        on_step(d, t);
+    };
+    let stop = || interrupt.is_requested();
+    let x0 = if req.mirror_average {
+        let averaged = MirrorAveraged::new(model, &bundle.vocab, &bundle.mean, &bundle.std, device);
+        sample_chain_until(
+            &averaged,
+            &schedule,
+            req.sampler,
+            x_t,
+            &cond,
+            &mut noise,
+            on_step,
+            &stop,
+        )
+    } else {
+        sample_chain_until(
+            &model,
+            &schedule,
+            req.sampler,
+            x_t,
+            &cond,
+            &mut noise,
+            on_step,
+            &stop,
+        )
+    }
     .ok_or(GenerateError::Interrupted { done, total })?;
     let features = denormalize_host(bundle, x0);
     if features.iter().any(|v| !v.is_finite()) {

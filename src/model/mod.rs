@@ -8,6 +8,7 @@ pub mod config;
 pub mod denoiser;
 pub mod ema;
 pub mod generate;
+pub mod mirror;
 pub mod noise;
 pub mod sampler;
 pub mod schedule;

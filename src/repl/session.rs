@@ -255,6 +255,7 @@ impl Session {
             seed,
             sampler: SamplerKind::Ddim(50),
             guidance_scale: 2.5,
+            mirror_average: false,
         };
         let device = self.device.clone();
         let out = match self.bundle() {

@@ -274,6 +274,7 @@ fn plain_solve_reproduces_generate() {
         seed: req.seed,
         sampler: kind,
         guidance_scale: 2.5,
+        mirror_average: false,
     };
     let g = generate(&bundle, &gen_req, &Device::flex(), |_, _| {}).unwrap();
     assert_eq!(out.features, g.features);
