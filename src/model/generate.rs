@@ -1,6 +1,7 @@
 //! Text-to-motion generation with a model bundle: seeded noise → sampler chain →
 //! de-normalised features → joints. Batched over `count` samples.
 
+use super::denoiser::Denoiser;
 use super::mirror::MirrorAveraged;
 use super::noise::NoiseSource;
 use super::sampler::{Condition, SamplerKind, sample_chain_until, schedule_for};
@@ -122,30 +123,23 @@ pub fn generate_interruptible(
         on_step(d, t);
     };
     let stop = || interrupt.is_requested();
-    let x0 = if req.mirror_average {
-        let averaged = MirrorAveraged::new(model, &bundle.vocab, &bundle.mean, &bundle.std, device);
-        sample_chain_until(
-            &averaged,
-            &schedule,
-            req.sampler,
-            x_t,
-            &cond,
-            &mut noise,
-            on_step,
-            &stop,
-        )
+    let averaged;
+    let den: &dyn Denoiser = if req.mirror_average {
+        averaged = MirrorAveraged::new(model, &bundle.vocab, &bundle.mean, &bundle.std, device);
+        &averaged
     } else {
-        sample_chain_until(
-            &model,
-            &schedule,
-            req.sampler,
-            x_t,
-            &cond,
-            &mut noise,
-            on_step,
-            &stop,
-        )
-    }
+        &model
+    };
+    let x0 = sample_chain_until(
+        den,
+        &schedule,
+        req.sampler,
+        x_t,
+        &cond,
+        &mut noise,
+        on_step,
+        &stop,
+    )
     .ok_or(GenerateError::Interrupted { done, total })?;
     let features = denormalize_host(bundle, x0);
     if features.iter().any(|v| !v.is_finite()) {

@@ -49,7 +49,7 @@ impl Condition {
 
 /// x̂0 with classifier-free guidance: uncond + s·(cond − uncond), both passes in one batch.
 pub fn guided_x0(
-    den: &impl Denoiser,
+    den: &(impl Denoiser + ?Sized),
     x_t: Tensor<3>,
     timestep: usize,
     cond: &Condition,
@@ -115,7 +115,7 @@ pub fn sample_chain(
 /// so (an interrupted run: nothing is sampled to the end).
 #[allow(clippy::too_many_arguments)]
 pub fn sample_chain_until(
-    den: &impl Denoiser,
+    den: &(impl Denoiser + ?Sized),
     schedule: &NoiseSchedule,
     kind: SamplerKind,
     mut x_t: Tensor<3>,
