@@ -5,8 +5,8 @@
 # chain (with the unguided DDIM-10 sample next to it), programs with several people also
 # with `lbfgs` (InterControl's solver) at its defaults, then regenerates the cookbook pages
 # so they include them. The runs are listed in src/docgen/book.rs (COOKBOOK_RENDERS).
-# Run from the repository root; about one minute per program for guide and 1.5 for
-# latent on a 2-core CPU (19 programs: about 50 minutes).
+# Run from the repository root; about one minute per program for guide and 2.5 for
+# latent on a 2-core CPU (19 programs: about 70 minutes).
 # MPROG=path/to/mprog to use a built binary; ONLY=stem to render one program;
 # SOLVERS="guide lbfgs" to render only those solvers (default: guide latent lbfgs).
 set -euo pipefail
@@ -24,7 +24,7 @@ for prog in programs/*.mprog; do
     fi
     if wants latent; then
         echo "== $stem (latent)"
-        $mprog run "$prog" --solver latent --knob ddim_steps=10 --knob iterations=30 --knob lr=0.02 \
+        $mprog run "$prog" --solver latent --knob ddim_steps=10 --knob iterations=60 --knob lr=0.02 \
             --seed 1 -o "$out/$stem-latent.png" | tee "$out/$stem-latent.md"
     fi
     if wants lbfgs && grep -q '^people' "$prog"; then

@@ -81,7 +81,7 @@ pub const COOKBOOK_RENDERS: [(&str, &str, &str); 3] = [
     (
         "-latent",
         "latent",
-        " --knob ddim_steps=10 --knob iterations=30 --knob lr=0.02",
+        " --knob ddim_steps=10 --knob iterations=60 --knob lr=0.02",
     ),
     // InterControl's own solver, rendered for programs with several people only.
     ("-lbfgs", "lbfgs", " --no-baseline"),
