@@ -8,9 +8,10 @@ use mprog::eval::scores::fid;
 use mprog::model::ModelBundle;
 use mprog::model::weights::default_model_dir;
 use mprog::solve::{Prior, Solver};
+use mprog::tasks::head_height;
 use mprog::tasks::report::{Realism, RunInfo, markdown};
 use mprog::tasks::suite::{
-    SolverSettings, SuiteSize, Task, keyframe_suite, program_suite, solvers,
+    Family, SolverSettings, SuiteSize, Task, keyframe_suite, program_suite, solvers,
 };
 use mprog::tasks::{RunRow, run_task};
 use std::path::PathBuf;
@@ -38,6 +39,12 @@ pub struct TaskBenchArgs {
     /// Test clips for keyframe control (full run).
     #[arg(long, default_value_t = 4)]
     clips: usize,
+    /// Test clips for the head-height task, PMG's HSI-1 with the clips' own targets (full run).
+    #[arg(long, default_value_t = 4)]
+    head_clips: usize,
+    /// Only these task families (comma separated: pmg, head-height, keyframe, contact).
+    #[arg(long, value_delimiter = ',', value_enum)]
+    family: Vec<Family>,
     /// Only these solvers (comma separated: plain, guide, latent, ik, ik-reg, lbfgs).
     #[arg(long, value_delimiter = ',')]
     solvers: Vec<String>,
@@ -175,7 +182,7 @@ pub fn run(args: TaskBenchArgs) -> Result<()> {
     let size = if args.quick {
         SuiteSize::quick()
     } else {
-        SuiteSize::full(args.samples.max(1), args.clips.max(1))
+        SuiteSize::full(args.samples.max(1), args.clips.max(1), args.head_clips)
     };
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let bundle = ModelBundle::load(&dir, &device)
@@ -187,14 +194,27 @@ pub fn run(args: TaskBenchArgs) -> Result<()> {
         Ok(d) => Some(d),
         Err(e) => {
             eprintln!(
-                "keyframe control and realism skipped: no dataset at {} ({e}); build it with `mprog data build`",
+                "head heights, keyframe control and realism skipped: no dataset at {} ({e}); build it with `mprog data build`",
                 args.data.display()
             );
             None
         }
     };
     if let Some(d) = &data {
+        tasks.extend(
+            head_height::suite(d, size.head_clips, size.samples).map_err(|e| miette!("{e}"))?,
+        );
         tasks.extend(keyframe_suite(d, &size, args.seed).map_err(|e| miette!("{e}"))?);
+    }
+    if !args.family.is_empty() {
+        tasks.retain(|t| args.family.contains(&t.family));
+    }
+    if tasks.is_empty() {
+        return Err(miette!(
+            "no tasks to run: --quick has no head-height tasks, and head heights and keyframe \
+             control need the dataset ({})",
+            args.data.display()
+        ));
     }
     let runs = tasks.len() * list.len();
     eprintln!(

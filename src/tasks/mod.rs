@@ -6,9 +6,11 @@
 //! | --- | --- | --- |
 //! | which tasks and settings | [`suite`] | programs, test clips → [`suite::Task`]s, solvers |
 //! | keyframe targets, control metrics | [`keyframe`] | a test clip → batched goal; distances → [`keyframe::ControlErrors`] |
+//! | PMG's HSI-1 on test clips | [`head_height`] | a test clip → its head-height program |
 //! | solving and measuring | this module | tasks × solvers → [`RunRow`]s |
 //! | the markdown | [`report`] | rows → tables |
 
+pub mod head_height;
 pub mod keyframe;
 pub mod report;
 pub mod suite;

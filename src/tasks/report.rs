@@ -77,7 +77,12 @@ pub fn markdown(info: &RunInfo, rows: &[RunRow], realism: &Realism) -> String {
          against held-out test clips (the evaluator of `mprog eval`; motions in brackets; few \
          motions make it noisy). Lower is better everywhere."
     );
-    for family in [Family::Pmg, Family::Keyframe, Family::Contact] {
+    for family in [
+        Family::Pmg,
+        Family::HeadHeight,
+        Family::Keyframe,
+        Family::Contact,
+    ] {
         let fam: Vec<&RunRow> = rows.iter().filter(|r| r.family == family).collect();
         if fam.is_empty() {
             continue;

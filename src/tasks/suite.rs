@@ -8,11 +8,13 @@ use crate::solve::{GuideConfig, IkConfig, LatentConfig, LbfgsConfig, MotionError
 use burn::prelude::*;
 use std::path::Path;
 
-/// The three task families of the benchmark.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// The task families of the benchmark.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum)]
 pub enum Family {
     /// PMG's program tasks (`programs/`).
     Pmg,
+    /// PMG's HSI-1 with its targets from held-out test clips (PMG Table 1).
+    HeadHeight,
     /// OmniControl-style keyframe control on held-out test clips.
     Keyframe,
     /// InterControl-style contacts between two people (`programs/ic_*`).
@@ -24,6 +26,7 @@ impl Family {
     pub fn title(self) -> &'static str {
         match self {
             Family::Pmg => "PMG tasks",
+            Family::HeadHeight => "Head heights from test clips (PMG HSI-1, Table 1)",
             Family::Keyframe => "Keyframe control (OmniControl)",
             Family::Contact => "Two-person contact (InterControl)",
         }
@@ -120,6 +123,8 @@ pub struct SuiteSize {
     pub clips: usize,
     /// Frames of a keyframe-control motion (clips shorter than this are not used).
     pub keyframe_frames: usize,
+    /// Test clips for the head-height task (each its own prompt and length).
+    pub head_clips: usize,
 }
 
 impl SuiteSize {
@@ -130,16 +135,19 @@ impl SuiteSize {
             samples: 1,
             clips: 1,
             keyframe_frames: 60,
+            head_clips: 0,
         }
     }
 
-    /// Every task: 12 PMG tasks, 2 contact tasks, 6 joints × 5 densities per clip.
-    pub fn full(samples: usize, clips: usize) -> Self {
+    /// Every task: 12 PMG tasks, 2 contact tasks, 6 joints × 5 densities per clip, head
+    /// heights of `head_clips` clips.
+    pub fn full(samples: usize, clips: usize, head_clips: usize) -> Self {
         SuiteSize {
             quick: false,
             samples,
             clips,
             keyframe_frames: 120,
+            head_clips,
         }
     }
 }
@@ -237,7 +245,7 @@ pub fn keyframe_suite(data: &Dataset, size: &SuiteSize, seed: u64) -> Result<Vec
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum SolverSettings {
     /// Short chains sized for a 2-core CPU: 100 guided steps, DDIM-10 latent chains with
-    /// 40 Adam iterations, IK from DDIM-10 with 100 iterations at lr 0.05.
+    /// 60 Adam iterations, IK from DDIM-10 with 100 iterations at lr 0.05.
     Fast,
     /// The papers' defaults (1000 guided steps, DDIM-100 × 100 latent iterations, …):
     /// hours per task on a CPU, meant for a GPU.
@@ -268,11 +276,11 @@ pub fn solvers(settings: SolverSettings) -> Vec<Solver> {
             late_steps: 5,
             ..GuideConfig::default()
         }),
-        // 40 iterations: at 10, HSC-1 and GEO-1 stayed 0.11 and 0.16 off, at 40 0.025 and
-        // 0.036 (the book's task notes).
+        // 60 iterations, the cookbook's: with step 8,704, 30 left Fig. 1 0.105 off and 60
+        // 0.0004 (the solvers chapter); at 10, step 6,550 left HSC-1 0.11 off (task notes).
         Solver::Latent(LatentConfig {
             ddim_steps: 10,
-            iterations: 40,
+            iterations: 60,
             lr: 0.02,
             ..LatentConfig::default()
         }),
