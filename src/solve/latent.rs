@@ -39,6 +39,7 @@ use super::adam::Adam;
 use super::decode::RigidTensors;
 use super::host::{extract_head, insert_head};
 use super::place::Placement;
+use super::reference::ReferencePull;
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
 use super::{SolveError, host::check_shape};
@@ -75,6 +76,11 @@ pub struct LatentConfig {
     /// Measure and return the chain's output through the skeleton projection (see the
     /// module notes), with or without relaxation.
     pub keep_skeleton: bool,
+    /// Weight of PMG's pull of the root columns towards the iteration-0 sample
+    /// ([`super::reference`]; 0 = off, as PMG's configs without `reg`).
+    pub ref_root: f32,
+    /// Weight of the same pull on the leg columns.
+    pub ref_legs: f32,
 }
 
 impl Default for LatentConfig {
@@ -87,6 +93,8 @@ impl Default for LatentConfig {
             relax_lr: 0.02,
             checkpoint: false,
             keep_skeleton: true,
+            ref_root: 0.0,
+            ref_legs: 0.0,
         }
     }
 }
@@ -102,6 +110,15 @@ impl LatentConfig {
         if !(self.lr.is_finite() && self.lr >= 0.0 && self.relax_lr.is_finite()) {
             return Err(SolveError::Invalid(
                 "latent: learning rates must be finite".into(),
+            ));
+        }
+        if ![self.ref_root, self.ref_legs]
+            .iter()
+            .all(|w| w.is_finite() && *w >= 0.0)
+        {
+            return Err(SolveError::Invalid(
+                "latent: the reference pulls `ref_root` and `ref_legs` must be finite and ≥ 0"
+                    .into(),
             ));
         }
         Ok(())
@@ -192,6 +209,9 @@ pub(crate) fn run(
     };
     let mut g_rigid = Vec::new();
     let mut objective = ctx.host_objective();
+    let pull = ReferencePull::new(cfg.ref_root, cfg.ref_legs);
+    // The chain's raw output at iteration 0, which the pull holds the later ones to.
+    let mut reference: Option<Vec<f32>> = None;
     for it in 0..cfg.iterations {
         let at = || format!("iteration {}/{}", it + 1, cfg.iterations);
         let zt = Tensor::<3>::from_data(TensorData::new(z.clone(), dims), &ad).require_grad();
@@ -263,7 +283,17 @@ pub(crate) fn run(
         if it + 1 == cfg.iterations || !e.is_tracked() {
             break;
         }
-        let grads = e.sum().backward();
+        let mut loss = e.sum();
+        if let Some(pull) = &pull {
+            let raw = host(x.clone().detach());
+            let reference = reference.get_or_insert_with(|| raw.clone());
+            let mut g = vec![0.0; raw.len()];
+            pull.add(&raw, reference, ctx.frames, &mut g);
+            // ⟨x̂, g⟩ has the pull's gradient at this x̂.
+            let g = Tensor::<3>::from_data(TensorData::new(g, dims), &ad);
+            loss = loss + (x.clone() * g).sum();
+        }
+        let grads = loss.backward();
         let gz = if cfg.checkpoint {
             let g = x
                 .grad(&grads)

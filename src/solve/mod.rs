@@ -50,6 +50,7 @@ pub mod ik;
 pub mod latent;
 pub mod lbfgs;
 mod place;
+pub mod reference;
 mod request;
 mod run;
 

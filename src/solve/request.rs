@@ -97,7 +97,15 @@ impl Solver {
                 "split",
                 "late_root",
             ],
-            Solver::Latent(_) => &["ddim_steps", "iterations", "lr", "relax", "skeleton"],
+            Solver::Latent(_) => &[
+                "ddim_steps",
+                "iterations",
+                "lr",
+                "relax",
+                "skeleton",
+                "ref_root",
+                "ref_legs",
+            ],
             Solver::Ik(_) => &["ddim_steps", "iterations", "lr", "smoothness"],
             Solver::Lbfgs(_) => &[
                 "steps",
@@ -178,6 +186,8 @@ impl Solver {
                     }
                 }
                 "skeleton" => c.keep_skeleton = flag("off", "keep bone lengths")?,
+                "ref_root" => c.ref_root = real()? as f32,
+                "ref_legs" => c.ref_legs = real()? as f32,
                 _ => return Err(unknown()),
             },
             Solver::Ik(c) => match name {

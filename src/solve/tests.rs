@@ -1317,3 +1317,59 @@ fn lbfgs_smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
     bad.set_knob("smooth", -1.0).unwrap();
     assert_refused(&bundle, bad, "smooth");
 }
+
+#[test]
+fn the_reference_pull_keeps_the_legs_near_the_first_sample() {
+    use crate::solve::reference::leg_columns;
+    let bundle = tiny_bundle();
+    let first = run(
+        &bundle,
+        &request(&["a person walks"], Solver::Plain(SamplerKind::Ddim(8))),
+        &pelvis_at_end,
+    );
+    let legs = leg_columns();
+    // Squared distance of the leg columns to the unguided sample's (de-normalised features).
+    let drift = |r: &SolveResult| -> f32 {
+        r.features
+            .chunks_exact(FEATURE_DIM)
+            .zip(first.features.chunks_exact(FEATURE_DIM))
+            .map(|(a, b)| legs.iter().map(|&c| (a[c] - b[c]).powi(2)).sum::<f32>())
+            .sum()
+    };
+    let latent = |ref_legs: f32| {
+        let cfg = LatentConfig {
+            keep_skeleton: false,
+            ref_legs,
+            ..small_latent()
+        };
+        run(
+            &bundle,
+            &request(&["a person walks"], Solver::Latent(cfg)),
+            &pelvis_at_end,
+        )
+    };
+    let free = latent(0.0);
+    let pulled = latent(1.0);
+    eprintln!(
+        "leg drift free {} pulled {}; error free {} pulled {} (start {})",
+        drift(&free),
+        drift(&pulled),
+        free.error[0],
+        pulled.error[0],
+        free.trace[0][0]
+    );
+    assert!(drift(&pulled) < 0.25 * drift(&free));
+    // The program is still served, if more slowly: the tiny model moves its pelvis with
+    // its legs.
+    assert!(pulled.error[0] < 0.8 * pulled.trace[0][0]);
+    // The pull is not part of the reported error, and a zero pull changes nothing.
+    assert_eq!(free.trace[0], pulled.trace[0]);
+    let zero = Solver::Latent(LatentConfig {
+        keep_skeleton: false,
+        ..small_latent()
+    });
+    assert_eq!(
+        run(&bundle, &request(&["a person walks"], zero), &pelvis_at_end).features,
+        free.features
+    );
+}
