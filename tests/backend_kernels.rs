@@ -1,0 +1,255 @@
+//! The patched burn-flex kernels (`patches/burn-flex`, see `patches/README.md`) against
+//! f64 references: GELU and its gradient, `exp`, softmax, and element-wise arithmetic,
+//! each on a small tensor (the single-thread path) and a large one (split across the
+//! rayon pool), on a uniquely owned tensor (computed in place) and a shared one.
+
+use burn::tensor::activation::{gelu, softmax};
+use burn::tensor::{Device, Tensor, TensorData};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// flex's seeded RNG is one per process: the tests that draw from it take turns.
+static RNG: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Small enough for one thread, and large enough for the parallel path (≥ 32K elements).
+const SIZES: [usize; 2] = [1_000, 100_003];
+
+fn random(n: usize, lo: f32, hi: f32, seed: u64) -> Vec<f32> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n).map(|_| rng.random_range(lo..hi)).collect()
+}
+
+fn tensor(v: &[f32], device: &Device) -> Tensor<1> {
+    Tensor::from_data(TensorData::new(v.to_vec(), [v.len()]), device)
+}
+
+fn values(t: Tensor<1>) -> Vec<f32> {
+    t.into_data().try_into_vec::<f32>().unwrap()
+}
+
+/// erf in f64 by its Maclaurin series (|x| ≤ 3.5: 1e-12 or better after cancellation),
+/// and 1 - erfc by Lentz's continued fraction beyond.
+fn erf_f64(x: f64) -> f64 {
+    let a = x.abs();
+    let v = if a <= 3.5 {
+        let (mut term, mut sum, mut n) = (a, a, 0.0);
+        loop {
+            n += 1.0;
+            term *= -a * a / n;
+            let add = term / (2.0 * n + 1.0);
+            sum += add;
+            if add.abs() < 1e-17 * sum.abs() {
+                break;
+            }
+        }
+        sum * 2.0 / std::f64::consts::PI.sqrt()
+    } else {
+        // erfc(a) = exp(-a²)/√π · 1/(a + (1/2)/(a + 1/(a + (3/2)/(a + …))))
+        let mut f = a;
+        for k in (1..60).rev() {
+            f = a + (k as f64 / 2.0) / f;
+        }
+        1.0 - (-a * a).exp() / std::f64::consts::PI.sqrt() / f
+    };
+    v.copysign(x)
+}
+
+fn gelu_f64(x: f64) -> f64 {
+    0.5 * x * (1.0 + erf_f64(x / std::f64::consts::SQRT_2))
+}
+
+fn gelu_grad_f64(x: f64) -> f64 {
+    let pdf = (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    0.5 * (1.0 + erf_f64(x / std::f64::consts::SQRT_2)) + x * pdf
+}
+
+#[test]
+fn the_f64_reference_erf_is_right() {
+    // Values from Abramowitz & Stegun, table 7.1 and beyond.
+    for (x, want) in [
+        (0.5, 0.520_499_877_813_046_5),
+        (1.0, 0.842_700_792_949_714_9),
+        (2.0, 0.995_322_265_018_952_7),
+        (3.0, 0.999_977_909_503_001_4),
+        (4.0, 0.999_999_984_582_742_1),
+    ] {
+        assert!((erf_f64(x) - want).abs() < 1e-13, "erf({x})");
+        assert!((erf_f64(-x) + want).abs() < 1e-13, "erf(-{x})");
+    }
+}
+
+#[test]
+fn gelu_matches_the_erf_definition() {
+    let device = Device::flex();
+    for (seed, &n) in SIZES.iter().enumerate() {
+        let mut x = random(n, -8.0, 8.0, seed as u64);
+        x[..6].copy_from_slice(&[0.0, -0.0, 4.0 * std::f32::consts::SQRT_2, -6.0, 30.0, -30.0]);
+        let input = tensor(&x, &device);
+        // A shared input takes the allocating path, a unique one is computed in place.
+        let shared = values(gelu(input.clone()));
+        let unique = values(gelu(input));
+        assert_eq!(shared, unique, "n={n}: in-place and allocating paths differ");
+        for (&xi, &yi) in x.iter().zip(&unique) {
+            let want = gelu_f64(xi as f64);
+            let err = (yi as f64 - want).abs();
+            assert!(err <= 2e-6 * (1.0 + want.abs()), "gelu({xi}) = {yi}, want {want}");
+        }
+    }
+}
+
+#[test]
+fn gelu_gradient_matches_its_formula() {
+    let device = Device::flex().autodiff();
+    for (seed, &n) in SIZES.iter().enumerate() {
+        let x = random(n, -6.0, 6.0, 10 + seed as u64);
+        let upstream = random(n, -2.0, 2.0, 20 + seed as u64);
+        let input = tensor(&x, &device).require_grad();
+        let loss = (gelu(input.clone()) * tensor(&upstream, &device)).sum();
+        let grads = loss.backward();
+        let grad = values(input.grad(&grads).unwrap());
+        for ((&xi, &gi), &ui) in x.iter().zip(&grad).zip(&upstream) {
+            let want = ui as f64 * gelu_grad_f64(xi as f64);
+            assert!(
+                (gi as f64 - want).abs() <= 2e-6 * (1.0 + want.abs()),
+                "d gelu({xi}) · {ui} = {gi}, want {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn exp_is_accurate_and_keeps_its_edges() {
+    let device = Device::flex();
+    for (seed, &n) in SIZES.iter().enumerate() {
+        let x = random(n, -80.0, 80.0, 30 + seed as u64);
+        let shared_in = tensor(&x, &device);
+        let shared = values(shared_in.clone().exp());
+        let unique = values(shared_in.exp());
+        assert_eq!(shared, unique, "n={n}: in-place and allocating paths differ");
+        for (&xi, &yi) in x.iter().zip(&unique) {
+            let want = (xi as f64).exp();
+            assert!(
+                ((yi as f64 - want) / want).abs() < 1e-6,
+                "exp({xi}) = {yi}, want {want}"
+            );
+        }
+    }
+    let edges = values(tensor(&[0.0, 88.0, 89.0, 1e4, -90.0, -1e4, f32::NAN], &device).exp());
+    assert_eq!(edges[0], 1.0);
+    assert!(edges[1].is_finite() && (edges[1] / 88f32.exp() - 1.0).abs() < 1e-6);
+    assert_eq!(edges[2], f32::INFINITY);
+    assert_eq!(edges[3], f32::INFINITY);
+    assert!(edges[4] >= 0.0 && edges[4] < 1e-38);
+    assert_eq!(edges[5], 0.0);
+    assert!(edges[6].is_nan());
+}
+
+#[test]
+fn softmax_rows_sum_to_one_and_match_f64() {
+    let device = Device::flex();
+    let (rows, cols) = (400, 121);
+    let x = random(rows * cols, -20.0, 20.0, 40);
+    let t: Tensor<2> = Tensor::from_data(TensorData::new(x.clone(), [rows, cols]), &device);
+    let y = softmax(t, 1).into_data().try_into_vec::<f32>().unwrap();
+    for r in 0..rows {
+        let row = &x[r * cols..(r + 1) * cols];
+        let max = row.iter().fold(f64::MIN, |m, &v| m.max(v as f64));
+        let sum: f64 = row.iter().map(|&v| (v as f64 - max).exp()).sum();
+        for c in 0..cols {
+            let want = (row[c] as f64 - max).exp() / sum;
+            let got = y[r * cols + c] as f64;
+            assert!((got - want).abs() < 1e-6, "softmax[{r},{c}] = {got}, want {want}");
+        }
+    }
+}
+
+#[test]
+fn elementwise_arithmetic_is_exact_on_both_paths() {
+    let device = Device::flex();
+    for (seed, &n) in SIZES.iter().enumerate() {
+        let a = random(n, -3.0, 3.0, 50 + seed as u64);
+        let b = random(n, 0.5, 3.0, 60 + seed as u64);
+        let (ta, tb) = (tensor(&a, &device), tensor(&b, &device));
+        let cases: [(&str, Vec<f32>, fn(f32, f32) -> f32); 5] = [
+            ("add", values(ta.clone() + tb.clone()), |x, y| x + y),
+            ("sub", values(ta.clone() - tb.clone()), |x, y| x - y),
+            ("mul", values(ta.clone() * tb.clone()), |x, y| x * y),
+            ("div", values(ta.clone() / tb.clone()), |x, y| x / y),
+            ("mul_scalar", values(ta.clone() * 1.5), |x, _| x * 1.5),
+        ];
+        for (name, got, op) in cases {
+            for i in 0..n {
+                assert_eq!(got[i], op(a[i], b[i]), "{name}[{i}] (n={n})");
+            }
+        }
+        // In place (unique operands): the same numbers.
+        let inplace = values(tensor(&a, &device) * tensor(&b, &device) + 2.0);
+        for i in 0..n {
+            assert_eq!(inplace[i], a[i] * b[i] + 2.0, "in-place mul+add [{i}] (n={n})");
+        }
+    }
+}
+
+#[test]
+fn dropout_masks_keep_the_asked_fraction() {
+    use burn::tensor::Distribution;
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let device = Device::flex();
+    let n = 200_000;
+    let mask: Tensor<1> = Tensor::random([n], Distribution::Bernoulli(0.9), &device);
+    let kept = values(mask);
+    assert!(kept.iter().all(|&v| v == 0.0 || v == 1.0));
+    let frac = kept.iter().sum::<f32>() / n as f32;
+    // 5 standard deviations of a Binomial(200000, 0.9) fraction: 0.0034.
+    assert!((frac - 0.9).abs() < 0.0034, "kept {frac}");
+}
+
+#[test]
+fn select_gradient_scatters_back_to_every_index() {
+    // The backward of `select` on a 3-D tensor is the patched N-D select-add: repeated
+    // indices must accumulate, unselected rows get zero.
+    let device = Device::flex().autodiff();
+    let (b, rows, c) = (4, 50, 3);
+    let x = random(b * rows * c, -1.0, 1.0, 70);
+    let picks: Vec<i64> = vec![7, 0, 49, 7, 13, 7];
+    let upstream = random(b * picks.len() * c, -1.0, 1.0, 71);
+    let input: Tensor<3> =
+        Tensor::from_data(TensorData::new(x, [b, rows, c]), &device).require_grad();
+    let index = Tensor::<1, burn::tensor::Int>::from_data(
+        TensorData::new(picks.clone(), [picks.len()]),
+        &device,
+    );
+    let up: Tensor<3> = Tensor::from_data(
+        TensorData::new(upstream.clone(), [b, picks.len(), c]),
+        &device,
+    );
+    let loss = (input.clone().select(1, index) * up).sum();
+    let grads = loss.backward();
+    let grad = input.grad(&grads).unwrap().into_data().try_into_vec::<f32>().unwrap();
+    let mut want = vec![0.0f32; b * rows * c];
+    for bi in 0..b {
+        for (k, &r) in picks.iter().enumerate() {
+            for ci in 0..c {
+                want[(bi * rows + r as usize) * c + ci] += upstream[(bi * picks.len() + k) * c + ci];
+            }
+        }
+    }
+    for (i, (g, w)) in grad.iter().zip(&want).enumerate() {
+        assert!((g - w).abs() < 1e-6, "grad[{i}] = {g}, want {w}");
+    }
+}
+
+#[test]
+fn a_seeded_dropout_mask_repeats() {
+    use burn::tensor::Distribution;
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let device = Device::flex();
+    let draw = || {
+        device.seed(7);
+        values(Tensor::random([150_000], Distribution::Bernoulli(0.5), &device))
+    };
+    let (a, b) = (draw(), draw());
+    assert_eq!(a, b, "the same seed gave two masks");
+    // Blocks are seeded apart: the second 64K block is not a copy of the first.
+    assert_ne!(a[..1000], a[65_536..66_536]);
+}
