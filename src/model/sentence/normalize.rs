@@ -1,9 +1,11 @@
 //! BERT's basic tokenizer as Hugging Face `tokenizers` runs it for all-MiniLM-L6-v2
 //! (`BertNormalizer` with lowercase and accent stripping, then `BertPreTokenizer`):
-//! drop control characters, map whitespace to spaces, space out CJK ideographs, strip
-//! accents (NFD, drop Mn marks), lower-case, split on whitespace and punctuation.
+//! drop control and format characters, map whitespace to spaces, space out CJK
+//! ideographs, strip accents (NFD without Mn marks), lower-case, then split on whitespace
+//! and punctuation. The per-character tables are read off `tokenizers` itself, whose
+//! Unicode data is older than Rust's or Python's.
 
-use super::unicode_tables::{MARKS, OTHER, PUNCTUATION, STRIP};
+use super::unicode_tables::{MAP, PUNCTUATION, REMOVED};
 
 fn in_ranges(table: &[(u32, u32)], c: char) -> bool {
     let c = c as u32;
@@ -20,19 +22,6 @@ fn in_ranges(table: &[(u32, u32)], c: char) -> bool {
         .is_ok()
 }
 
-fn is_control(c: char) -> bool {
-    in_ranges(OTHER, c)
-}
-
-fn is_whitespace(c: char) -> bool {
-    c.is_whitespace()
-}
-
-/// `tokenizers` counts every ASCII symbol as punctuation too (`$`, `+`, `^`, …).
-fn is_punctuation(c: char) -> bool {
-    c.is_ascii_punctuation() || in_ranges(PUNCTUATION, c)
-}
-
 /// The CJK blocks of BERT's `_is_chinese_char` (each ideograph becomes its own word).
 fn is_cjk(c: char) -> bool {
     matches!(c as u32,
@@ -40,19 +29,25 @@ fn is_cjk(c: char) -> bool {
         | 0x2B740..=0x2B81F | 0x2B820..=0x2CEAF | 0xF900..=0xFAFF | 0x2F800..=0x2FA1F)
 }
 
-/// Pushes `c` with its accents stripped: the NFD decomposition without Mn marks.
-fn push_stripped(c: char, out: &mut String) {
+/// Pushes the normalised form of one character (the normaliser works per character).
+fn push_normalized(c: char, out: &mut String) {
     const S_BASE: u32 = 0xAC00;
     let code = c as u32;
-    if (S_BASE..S_BASE + 11172).contains(&code) {
-        // Hangul syllables decompose arithmetically into conjoining jamo (no marks).
+    if in_ranges(REMOVED, c) {
+    } else if let Ok(i) = MAP.binary_search_by_key(&code, |&(k, _)| k) {
+        out.push_str(MAP[i].1);
+    } else if (S_BASE..S_BASE + 11172).contains(&code) {
+        // Hangul syllables decompose arithmetically into conjoining jamo (NFD).
         let s = code - S_BASE;
         let jamo = [0x1100 + s / 588, 0x1161 + (s % 588) / 28, 0x11A7 + s % 28];
         let n = if s.is_multiple_of(28) { 2 } else { 3 };
         out.extend(jamo[..n].iter().filter_map(|&j| char::from_u32(j)));
-    } else if in_ranges(MARKS, c) {
-    } else if let Ok(i) = STRIP.binary_search_by_key(&code, |&(k, _)| k) {
-        out.push_str(STRIP[i].1);
+    } else if is_cjk(c) {
+        out.push(' ');
+        out.push(c);
+        out.push(' ');
+    } else if c.is_whitespace() {
+        out.push(' ');
     } else {
         out.push(c);
     }
@@ -60,22 +55,11 @@ fn push_stripped(c: char, out: &mut String) {
 
 /// The normalised text of `text` (before splitting).
 pub fn normalize(text: &str) -> String {
-    let mut stripped = String::with_capacity(text.len());
+    let mut out = String::with_capacity(text.len());
     for c in text.chars() {
-        if c == '\0' || c == '\u{FFFD}' || is_control(c) {
-            continue;
-        }
-        if is_whitespace(c) {
-            stripped.push(' ');
-        } else if is_cjk(c) {
-            stripped.push(' ');
-            stripped.push(c);
-            stripped.push(' ');
-        } else {
-            push_stripped(c, &mut stripped);
-        }
+        push_normalized(c, &mut out);
     }
-    stripped.chars().flat_map(char::to_lowercase).collect()
+    out
 }
 
 /// Normalises `text` and splits it into words: runs of non-space, non-punctuation
@@ -84,11 +68,12 @@ pub fn basic_tokens(text: &str) -> Vec<String> {
     let mut words = Vec::new();
     let mut word = String::new();
     for c in normalize(text).chars() {
-        if is_whitespace(c) || is_punctuation(c) {
+        let punct = in_ranges(PUNCTUATION, c);
+        if c.is_whitespace() || punct {
             if !word.is_empty() {
                 words.push(std::mem::take(&mut word));
             }
-            if is_punctuation(c) {
+            if punct {
                 words.push(c.to_string());
             }
         } else {
@@ -120,20 +105,21 @@ mod tests {
             ["ab", "c", "跳", "d"]
         );
         assert_eq!(basic_tokens("$5+x"), ["$", "5", "+", "x"]);
-        assert!(basic_tokens(" \n\t ").is_empty());
+        assert!(basic_tokens(" \n\t\u{3000} ").is_empty());
     }
 
     #[test]
     fn decomposes_hangul_and_drops_combining_marks() {
         assert_eq!(normalize("한"), "\u{1112}\u{1161}\u{11AB}");
         assert_eq!(normalize("e\u{0301}"), "e");
+        assert_eq!(normalize("İẞΣ"), "ißσ");
     }
 
     #[test]
     fn tables_are_sorted_for_binary_search() {
-        for t in [PUNCTUATION, OTHER, MARKS] {
+        for t in [PUNCTUATION, REMOVED] {
             assert!(t.windows(2).all(|w| w[0].1 < w[1].0));
         }
-        assert!(STRIP.windows(2).all(|w| w[0].0 < w[1].0));
+        assert!(MAP.windows(2).all(|w| w[0].0 < w[1].0));
     }
 }
