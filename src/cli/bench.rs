@@ -48,6 +48,13 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
     }
 }
 
+/// Waits for the device's queued work (a no-op on the CPU).
+fn sync(device: &Device) {
+    if let Err(e) = device.sync() {
+        eprintln!("(device sync failed: {e:?})");
+    }
+}
+
 fn median_ms(reps: usize, mut f: impl FnMut()) -> f64 {
     f(); // warm-up
     let mut times: Vec<f64> = (0..reps)
@@ -119,7 +126,11 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
             let inp = input(b, &ad);
             median_ms(args.reps, || {
                 let loss = train.predict_x0(&inp).powi_scalar(2).mean();
-                let _ = loss.backward();
+                // Read the loss and wait for the backward: a GPU backend runs both
+                // asynchronously, and an unread result is never waited for.
+                let _ = loss.clone().into_scalar::<f32>();
+                let _grads = loss.backward();
+                sync(&ad);
             })
         })
         .collect();
