@@ -60,8 +60,8 @@ pub struct RunArgs {
     /// Model bundle folder (default: models/default).
     #[arg(long)]
     model: Option<PathBuf>,
-    /// Outputs by extension: .bvh (several people: one file each, `out_p1.bvh`, …), .npy, .json, .gif, .png, .html.
-    #[arg(short, long, num_args = 1.., required = true)]
+    /// Outputs; each one's extension picks its kind (`--help` lists them).
+    #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
     #[command(flatten)]
     export: super::export::ExportArgs,

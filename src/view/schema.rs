@@ -37,7 +37,7 @@
 //! schema, so a caller that ran a program can store what it drew.
 
 use super::ViewError;
-use crate::formats::Meta;
+use crate::motion::Meta;
 use crate::render::Overlay;
 use crate::skeleton::{JOINT_NAMES, NUM_JOINTS, joint_index};
 use glam::{Vec2, Vec3};
