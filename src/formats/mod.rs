@@ -9,6 +9,7 @@
 pub mod bvh;
 pub mod bvh_export;
 mod file;
+pub mod gltf;
 pub mod json;
 pub mod npy;
 pub mod outputs;

@@ -79,6 +79,13 @@ pub const OUTPUT_KINDS: &[OutputKind] = &[
         encode: writers::json,
     },
     OutputKind {
+        extensions: &["glb"],
+        what: "glTF 2.0 binary: each person a skeleton of joint nodes (rest offsets) animated by rotations and root translation; for three.js, game engines, Blender",
+        file_per_person: false,
+        sidecar: Sidecar::None,
+        encode: super::gltf::encode,
+    },
+    OutputKind {
         extensions: &["gif"],
         what: "an animated stick figure: side view and a top view of the path, with the program's geometry",
         file_per_person: false,
