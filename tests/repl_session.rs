@@ -289,6 +289,12 @@ fn commands_report_usage() {
     assert!(fails(&mut s, ":nope").contains(":help"));
     assert!(say(&mut s, ":help").contains(":grad STATEMENT"));
     assert!(say(&mut s, ":help eval").contains(":eval EXPR"));
+    // The solvers and their knobs come from the registry.
+    let run = say(&mut s, ":help run");
+    assert!(
+        run.contains("lbfgs:") && run.contains("k_late=500"),
+        "{run}"
+    );
     assert!(s.handle(":quit").quit);
 }
 

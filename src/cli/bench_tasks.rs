@@ -45,7 +45,8 @@ pub struct TaskBenchArgs {
     /// Only these task families (comma separated: pmg, head-height, keyframe, contact).
     #[arg(long, value_delimiter = ',', value_enum)]
     family: Vec<Family>,
-    /// Only these solvers (comma separated: plain, guide, latent, ik, ik-reg, lbfgs).
+    /// Only these solvers, comma separated (default: every registered one; `mprog run --help`
+    /// lists them).
     #[arg(long, value_delimiter = ',')]
     solvers: Vec<String>,
     /// Override a solver setting for this run: `--knob latent.iterations=20`.

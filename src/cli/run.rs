@@ -38,8 +38,8 @@ fn body_summary(people: &[Motion]) -> String {
 pub struct RunArgs {
     /// The program.
     program: PathBuf,
-    /// Solver: guide (OmniControl), latent (PMG), ik, ik-reg, lbfgs (InterControl), plain.
-    #[arg(long, default_value = "guide")]
+    /// Solver (`--help` lists them with their knobs and defaults).
+    #[arg(long, default_value = "guide", long_help = solvers_long_help())]
     solver: String,
     /// Solver setting, repeatable: `--knob iterations=30 --knob ddim_steps=20` (latent),
     /// `--knob steps=100` (guide, lbfgs, plain); an unknown name lists the valid ones.
@@ -129,11 +129,15 @@ fn solve_with_bar(
     Ok(out)
 }
 
+fn solvers_long_help() -> String {
+    format!("Solver, one of:\n{}", mprog::solve::solvers_help())
+}
+
 /// The solver named `name` with the `--knob` settings applied.
 pub fn solver_with_knobs(name: &str, knobs: &[(String, f64)]) -> Result<Solver> {
     let mut solver = Solver::by_name(name).ok_or_else(|| {
         miette!(
-            help = "use guide, latent, ik, ik-reg, lbfgs or plain",
+            help = format!("use {}", Solver::names().join(", ")),
             "unknown solver `{name}`"
         )
     })?;

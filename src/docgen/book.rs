@@ -171,6 +171,10 @@ pub fn pages(programs: &[ProgramFile], book_src: &Path) -> Vec<(PathBuf, String)
             PathBuf::from(super::tables::OUTPUT_KINDS_PAGE),
             super::tables::output_kinds_table(),
         ),
+        (
+            PathBuf::from(super::tables::SOLVER_KNOBS_PAGE),
+            super::tables::solver_knobs_table(),
+        ),
     ];
     for p in programs {
         out.push((

@@ -107,7 +107,7 @@ pub const COMMANDS: &[CommandDoc] = &[
         "run",
         &[],
         "[SOLVER] [SEED] [KNOB=VALUE …]",
-        "solve the session's program with the model (guide, latent, lbfgs, ik, ik-reg, plain; default guide, seed 1); the result becomes the current motion",
+        "solve the session's program with the model (`:help run` lists the solvers and their knobs; default guide, seed 1); the result becomes the current motion",
     ),
     doc(
         "eval",

@@ -299,7 +299,8 @@ impl Session {
         };
         let Some(mut solver) = Solver::by_name(name) else {
             return Reply::error(format!(
-                "unknown solver `{name}`; use guide, latent, lbfgs, ik, ik-reg or plain"
+                "unknown solver `{name}`; use {}",
+                Solver::names().join(", ")
             ));
         };
         for (k, v) in knobs {
@@ -486,6 +487,14 @@ pub fn real_errors(d: &Diagnostics) -> bool {
 fn help(topic: Option<&str>) -> Reply {
     if let Some(t) = topic {
         return match command::find(t) {
+            Some(c) if c.name == "run" => Reply::text(format!(
+                ":{} {}\n    {}{}\nSolvers:\n{}",
+                c.name,
+                c.args,
+                c.help,
+                aliases(c),
+                crate::solve::solvers_help()
+            )),
             Some(c) => Reply::text(format!(
                 ":{} {}\n    {}{}",
                 c.name,
