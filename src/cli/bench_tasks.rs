@@ -3,8 +3,8 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::dataset::{Dataset, FEATURE_DIM, Split};
-use mprog::eval::evaluator::{Evaluator, default_evaluator_dir};
-use mprog::eval::scores::fid;
+use mprog::metrics::evaluator::{Evaluator, default_evaluator_dir};
+use mprog::metrics::scores::fid;
 use mprog::model::ModelBundle;
 use mprog::model::weights::default_model_dir;
 use mprog::solve::{Prior, Solver};

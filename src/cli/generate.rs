@@ -3,10 +3,10 @@
 use super::io::{check_outputs, numbered, write_outputs_with};
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr};
-use mprog::eval::metrics::MotionMetrics;
-use mprog::eval::table::motions_markdown;
 use mprog::formats::Meta;
 use mprog::interrupt::Interrupt;
+use mprog::metrics::per_motion::MotionMetrics;
+use mprog::metrics::table::motions_markdown;
 use mprog::model::ModelBundle;
 use mprog::model::generate::{GenerateError, GenerateRequest, generate_interruptible};
 use mprog::model::sampler::SamplerKind;

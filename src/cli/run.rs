@@ -18,7 +18,7 @@ use std::path::PathBuf;
 /// One line on how physical the result is: a solver that stretched limbs, shook joints or
 /// slid the feet to meet the program shows here (the numbers `mprog bench tasks` reports).
 fn body_summary(people: &[Motion]) -> String {
-    use mprog::eval::metrics::{foot_skating_ratio, max_acceleration, max_bone_error};
+    use mprog::metrics::per_motion::{foot_skating_ratio, max_acceleration, max_bone_error};
     let worst = |f: fn(&Motion) -> f32| people.iter().map(f).fold(0.0, f32::max);
     format!(
         "body: bone lengths within {:.1} cm of the skeleton's, foot skating {:.2}, max joint acceleration {:.3} m/frame²{}",

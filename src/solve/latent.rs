@@ -41,7 +41,7 @@ use crate::model::sampler::SamplerKind;
 use super::adam::Adam;
 use super::decode::RigidTensors;
 use super::host::{extract_head, insert_head};
-use super::place::Placement;
+use crate::scene::Placement;
 use super::reference::ReferencePull;
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};

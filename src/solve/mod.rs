@@ -51,7 +51,6 @@ mod decode;
 pub mod feet;
 pub mod host;
 pub mod knobs;
-mod place;
 pub mod reference;
 mod request;
 mod run;
@@ -87,54 +86,19 @@ registry! {
 #[cfg(test)]
 mod tests;
 
+pub use crate::scene::{DEFAULT_SPACING, Placement};
 pub use decode::{Decoder, RigidTensors};
 pub use guide::{GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;
 pub use knobs::{KnobKind, KnobValue};
 pub use latent::{LatentConfig, Relax};
 pub use lbfgs::LbfgsConfig;
-pub use place::{DEFAULT_SPACING, Placement};
 pub use plain::PlainConfig;
 pub use request::{Phase, Prior, Progress, SolveRequest, SolveResult};
 pub use run::{Ctx, Outcome, solve};
 pub use solver::{Solver, SolverConfig, SolverSpec, solvers_help};
 
-use burn::tensor::Tensor;
-
-/// Differentiable error of a batch of motions: joints `[batch, people, frames, 22, 3]`
-/// (metres, Y up, world placement applied) → total error per sample `[batch]`.
-///
-/// Solvers minimise it. It must be built from burn tensor ops on the input's device so
-/// gradients reach the joints; it is called on plain and on autodiff devices. Closures
-/// `Fn(Tensor<5>) -> Tensor<1>` implement it.
-pub trait MotionError {
-    /// `[batch]` error of each sample.
-    fn error(&self, joints: Tensor<5>) -> Tensor<1>;
-
-    /// `[batch, terms]`: the error split into terms that sum to [`Self::error`] (a
-    /// program's statements). The guide sizes a step for each term on its own, so a stiff
-    /// term cannot set the pace of the others; one term by default.
-    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
-        self.error(joints).unsqueeze_dim(1)
-    }
-}
-
-/// A program's error is the sum of its statements' errors; its terms are the statements.
-impl MotionError for crate::lang::Program {
-    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
-        self.evaluate(joints).total
-    }
-
-    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
-        self.evaluate(joints).per_statement
-    }
-}
-
-impl<F: Fn(Tensor<5>) -> Tensor<1>> MotionError for F {
-    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
-        self(joints)
-    }
-}
+pub use crate::objective::MotionError;
 
 /// Why a solve failed.
 #[derive(Debug, thiserror::Error)]

@@ -1,11 +1,11 @@
 //! The common solver API: what to solve ([`SolveRequest`]), with which model
 //! ([`Prior`]), what comes back ([`SolveResult`]) and progress reports ([`Progress`]).
 
-use super::place::Placement;
 use super::solver::Solver;
 use crate::model::text::Vocabulary;
 use crate::model::{Mdm, ModelBundle};
 use crate::motion::Motion;
+use crate::scene::Placement;
 
 /// The motion prior the solvers steer: denoiser, vocabulary and normalisation statistics.
 #[derive(Clone, Copy, Debug)]

@@ -4,7 +4,6 @@
 
 use super::decode::Decoder;
 use super::host::{HostObjective, check_shape};
-use super::place::{DEFAULT_SPACING, Placement};
 use super::request::{Phase, Prior, Progress, SolveRequest, SolveResult};
 use super::{MotionError, SolveError};
 use crate::features::{FEATURE_DIM, recover_from_ric};
@@ -13,6 +12,7 @@ use crate::model::noise::NoiseSource;
 use crate::model::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::motion::Motion;
+use crate::scene::{DEFAULT_SPACING, Placement};
 use crate::skeleton::NUM_JOINTS;
 use burn::prelude::*;
 use std::time::Instant;
