@@ -149,15 +149,10 @@ fn main() {
                 let plain = go(
                     &bundle,
                     &task,
-                    Solver::Plain(SamplerKind::Ddpm(1000)),
+                    Solver::plain(SamplerKind::Ddpm(1000)),
                     frames,
                 );
-                let guided = go(
-                    &bundle,
-                    &task,
-                    Solver::Guide(GuideConfig::default()),
-                    frames,
-                );
+                let guided = go(&bundle, &task, Solver::new(GuideConfig::default()), frames);
                 println!(
                     "  unguided DDPM-1000: error {:.4} in {:.1} s; guide: error {:.4} in {:.1} s; time ratio {:.3}",
                     plain.error[0],
@@ -182,9 +177,9 @@ fn main() {
                 }
                 println!("{}:", task.name);
                 let solver = match mode {
-                    "lbfgs" => Solver::Lbfgs(LbfgsConfig::default()),
-                    "ik" => Solver::Ik(IkConfig::ik_reg()),
-                    _ => Solver::Latent(LatentConfig {
+                    "lbfgs" => Solver::new(LbfgsConfig::default()),
+                    "ik" => Solver::new(IkConfig::ik_reg()),
+                    _ => Solver::new(LatentConfig {
                         iterations,
                         ddim_steps: ddim,
                         ..LatentConfig::default()

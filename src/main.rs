@@ -18,7 +18,7 @@ enum Command {
     Joints,
     /// Generate motions from text with the shipped model.
     Gen(cli::generate::GenArgs),
-    /// Convert a motion file to other formats (by extension: bvh, npy, json, gif, png).
+    /// Convert a motion file to other formats (each output's extension picks its kind).
     Convert(cli::convert::ConvertArgs),
     /// Render a motion file as an animated GIF or a PNG strip.
     Render(cli::convert::RenderArgs),

@@ -7,6 +7,10 @@
 use crate::skeleton::{FPS, NUM_JOINTS};
 use glam::Vec3;
 
+/// Free-form metadata that travels with a motion (seed, program, solver settings, scene
+/// geometry); files that have room for it store it (`.json`, `.npy` sidecars).
+pub type Meta = serde_json::Map<String, serde_json::Value>;
+
 /// One pose: the 22 global joint positions of a frame.
 pub type Pose = [Vec3; NUM_JOINTS];
 

@@ -93,6 +93,9 @@ pub const REST_PELVIS_HEIGHT: f32 = 0.837;
 
 /// Foot joints used for contacts: (left ankle, left foot), (right ankle, right foot).
 pub const FOOT_LEFT: [usize; 2] = [7, 10];
+/// The foot joints (`left_foot`, `right_foot`, the toes): what foot skating measures and
+/// the foot lock holds.
+pub const FEET: [usize; 2] = [10, 11];
 /// See [`FOOT_LEFT`].
 pub const FOOT_RIGHT: [usize; 2] = [8, 11];
 /// Joints whose positions define the facing direction: r_hip, l_hip, r_shoulder, l_shoulder.

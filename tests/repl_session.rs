@@ -289,6 +289,12 @@ fn commands_report_usage() {
     assert!(fails(&mut s, ":nope").contains(":help"));
     assert!(say(&mut s, ":help").contains(":grad STATEMENT"));
     assert!(say(&mut s, ":help eval").contains(":eval EXPR"));
+    // The solvers and their knobs come from the registry.
+    let run = say(&mut s, ":help run");
+    assert!(
+        run.contains("lbfgs:") && run.contains("k_late=500"),
+        "{run}"
+    );
     assert!(s.handle(":quit").quit);
 }
 
@@ -359,12 +365,14 @@ fn save_writes_the_program_and_the_motion_with_its_scores() {
     say(&mut s, &format!(":save {}", npy.display()));
     assert!(dir.path().join("walk.meta.json").exists());
 
-    assert!(
-        fails(
-            &mut s,
-            &format!(":save {}", dir.path().join("x.gif").display())
-        )
-        .contains(":render")
+    // Every output kind of the table, pictures included.
+    let gif = dir.path().join("x.gif");
+    assert!(say(&mut s, &format!(":save {}", gif.display())).contains("wrote"));
+    assert!(std::fs::metadata(&gif).unwrap().len() > 1000);
+    let txt = fails(
+        &mut s,
+        &format!(":save {}", dir.path().join("x.txt").display()),
     );
+    assert!(txt.contains(".bvh") && txt.contains(".mprog"), "{txt}");
     assert!(fails(&mut Session::new(None), ":save p.mprog").contains("empty"));
 }

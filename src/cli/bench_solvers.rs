@@ -105,15 +105,15 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
 
     let guide = GuideConfig::default();
     let plain_ddpm = run(
-        Solver::Guide(guide.clone()).unguided(),
+        Solver::new(guide.clone()).unguided(),
         &format!("plain DDPM-{}", guide.steps),
     )?;
-    let guided = run(Solver::Guide(guide.clone()), "guide (fused inner loop)")?;
+    let guided = run(Solver::new(guide.clone()), "guide (fused inner loop)")?;
     let tape = if args.skip_tape {
         None
     } else {
         Some(run(
-            Solver::Guide(GuideConfig {
+            Solver::new(GuideConfig {
                 fused: false,
                 keep_skeleton: false,
                 foot_lock: 0.0,
@@ -130,11 +130,11 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
     let latent = LatentConfig::default();
     let iterations = args.latent_iterations.clamp(1, latent.iterations);
     let plain_ddim = run(
-        Solver::Latent(latent.clone()).unguided(),
+        Solver::new(latent.clone()).unguided(),
         &format!("plain DDIM-{}", latent.ddim_steps),
     )?;
     let latent_run = run(
-        Solver::Latent(LatentConfig {
+        Solver::new(LatentConfig {
             iterations,
             ..latent.clone()
         }),
@@ -146,7 +146,7 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
         lr: 0.02,
         ..latent.clone()
     };
-    let latent_fast = run(Solver::Latent(fast.clone()), "latent (10 × 30, lr 0.02)")?;
+    let latent_fast = run(Solver::new(fast.clone()), "latent (10 × 30, lr 0.02)")?;
 
     let frames = program.length();
     let mut md = String::new();

@@ -3,8 +3,8 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::dataset::{Dataset, FEATURE_DIM, Split};
-use mprog::eval::evaluator::{Evaluator, default_evaluator_dir};
-use mprog::eval::scores::fid;
+use mprog::metrics::evaluator::{Evaluator, default_evaluator_dir};
+use mprog::metrics::scores::fid;
 use mprog::model::ModelBundle;
 use mprog::model::weights::default_model_dir;
 use mprog::solve::{Prior, Solver};
@@ -45,7 +45,8 @@ pub struct TaskBenchArgs {
     /// Only these task families (comma separated: pmg, head-height, keyframe, contact).
     #[arg(long, value_delimiter = ',', value_enum)]
     family: Vec<Family>,
-    /// Only these solvers (comma separated: plain, guide, latent, ik, ik-reg, lbfgs).
+    /// Only these solvers, comma separated (default: every registered one; `mprog run --help`
+    /// lists them).
     #[arg(long, value_delimiter = ',')]
     solvers: Vec<String>,
     /// Override a solver setting for this run: `--knob latent.iterations=20`.

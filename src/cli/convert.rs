@@ -10,8 +10,8 @@ use std::path::PathBuf;
 pub struct ConvertArgs {
     /// Input motion: .bvh, .npy (N×22×3 joints or N×263 HumanML3D features) or .json.
     input: PathBuf,
-    /// Outputs, by extension: .bvh, .npy (+ .meta.json sidecar), .json, .gif, .png, .html.
-    #[arg(short, long, num_args = 1.., required = true)]
+    /// Outputs; each one's extension picks its kind (`--help` lists them).
+    #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
     #[command(flatten)]
     export: ExportArgs,
@@ -22,8 +22,8 @@ pub struct ConvertArgs {
 pub struct RenderArgs {
     /// Input motion: .bvh, .npy or .json.
     input: PathBuf,
-    /// Picture: .gif (animation), .png (strip of frames) or .html (interactive viewer).
-    #[arg(short, long, num_args = 1.., required = true)]
+    /// Outputs; each one's extension picks its kind (`--help` lists them).
+    #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
     /// Title drawn above the picture (default: the file name).
     #[arg(long)]

@@ -81,8 +81,8 @@ pub struct ShowArgs {
     /// Clip name (file stem, `_mirror` suffix for mirrored copies).
     #[arg(long)]
     clip: String,
-    /// Outputs (.gif, .png, .npy, .json, .bvh).
-    #[arg(short, long, num_args = 1.., required = true)]
+    /// Outputs; each one's extension picks its kind (`--help` lists them).
+    #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
 }
 

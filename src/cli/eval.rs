@@ -5,8 +5,8 @@ use clap::Subcommand;
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::dataset::Dataset;
-use mprog::eval::report::Sample;
-use mprog::eval::{
+use mprog::metrics::report::Sample;
+use mprog::metrics::{
     EncoderTrainConfig, EvalSettings, Evaluator, default_evaluator_dir, report_markdown, run_eval,
     train_evaluator,
 };

@@ -3,10 +3,10 @@
 use super::io::{check_outputs, numbered, write_outputs_with};
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr};
-use mprog::eval::metrics::MotionMetrics;
-use mprog::eval::table::motions_markdown;
 use mprog::formats::Meta;
 use mprog::interrupt::Interrupt;
+use mprog::metrics::per_motion::MotionMetrics;
+use mprog::metrics::table::motions_markdown;
 use mprog::model::ModelBundle;
 use mprog::model::generate::{GenerateError, GenerateRequest, generate_interruptible};
 use mprog::model::sampler::SamplerKind;
@@ -49,8 +49,8 @@ pub struct GenArgs {
     /// Model bundle folder (default: models/default).
     #[arg(long)]
     model: Option<PathBuf>,
-    /// Outputs by extension: .bvh .npy .json .gif .png (several allowed).
-    #[arg(short, long, num_args = 1.., required = true)]
+    /// Outputs; each one's extension picks its kind (`--help` lists them).
+    #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
     /// Keep the model's samples as they are: no foot cleanup (by default planted feet are
     /// held in place after sampling, the path unchanged).

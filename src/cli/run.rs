@@ -18,7 +18,7 @@ use std::path::PathBuf;
 /// One line on how physical the result is: a solver that stretched limbs, shook joints or
 /// slid the feet to meet the program shows here (the numbers `mprog bench tasks` reports).
 fn body_summary(people: &[Motion]) -> String {
-    use mprog::eval::metrics::{foot_skating_ratio, max_acceleration, max_bone_error};
+    use mprog::metrics::per_motion::{foot_skating_ratio, max_acceleration, max_bone_error};
     let worst = |f: fn(&Motion) -> f32| people.iter().map(f).fold(0.0, f32::max);
     format!(
         "body: bone lengths within {:.1} cm of the skeleton's, foot skating {:.2}, max joint acceleration {:.3} m/frame²{}",
@@ -38,8 +38,8 @@ fn body_summary(people: &[Motion]) -> String {
 pub struct RunArgs {
     /// The program.
     program: PathBuf,
-    /// Solver: guide (OmniControl), latent (PMG), ik, ik-reg, lbfgs (InterControl), plain.
-    #[arg(long, default_value = "guide")]
+    /// Solver (`--help` lists them with their knobs and defaults).
+    #[arg(long, default_value = "guide", long_help = solvers_long_help())]
     solver: String,
     /// Solver setting, repeatable: `--knob iterations=30 --knob ddim_steps=20` (latent),
     /// `--knob steps=100` (guide, lbfgs, plain); an unknown name lists the valid ones.
@@ -60,8 +60,8 @@ pub struct RunArgs {
     /// Model bundle folder (default: models/default).
     #[arg(long)]
     model: Option<PathBuf>,
-    /// Outputs by extension: .bvh (several people: one file each, `out_p1.bvh`, …), .npy, .json, .gif, .png, .html.
-    #[arg(short, long, num_args = 1.., required = true)]
+    /// Outputs; each one's extension picks its kind (`--help` lists them).
+    #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
     #[command(flatten)]
     export: super::export::ExportArgs,
@@ -129,11 +129,15 @@ fn solve_with_bar(
     Ok(out)
 }
 
+fn solvers_long_help() -> String {
+    format!("Solver, one of:\n{}", mprog::solve::solvers_help())
+}
+
 /// The solver named `name` with the `--knob` settings applied.
 pub fn solver_with_knobs(name: &str, knobs: &[(String, f64)]) -> Result<Solver> {
     let mut solver = Solver::by_name(name).ok_or_else(|| {
         miette!(
-            help = "use guide, latent, ik, ik-reg, lbfgs or plain",
+            help = format!("use {}", Solver::names().join(", ")),
             "unknown solver `{name}`"
         )
     })?;

@@ -7,7 +7,7 @@ use mprog::interrupt::Interrupt;
 use mprog::model::TrainConfig;
 use mprog::model::train::TrainRun;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `mprog train`.
 #[derive(clap::Args)]
@@ -106,6 +106,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         interrupt: interrupt.clone(),
         init_from: args.init_from.clone(),
         device: super::device()?,
+        after_checkpoint: Some(plot_loss_curves),
     };
     // The log's s/step is wall time over the last logged steps (checkpoints included), not
     // the run's lifetime mean, which carries every earlier session's speed.
@@ -142,4 +143,39 @@ pub fn run(args: TrainArgs) -> Result<()> {
         state.step, state.seconds, state.recent_loss, state.val_loss
     );
     Ok(())
+}
+
+/// `<out>/loss.png`: training loss (mean over 50-step windows) and validation loss, log y.
+fn plot_loss_curves(out: &Path) -> Result<(), String> {
+    let raw = mprog::model::train::read_curve(&out.join("loss.csv"), 1);
+    let train: Vec<(f32, f32)> = raw
+        .chunks(50)
+        .map(|c| {
+            let n = c.len() as f32;
+            (c[c.len() - 1].0, c.iter().map(|p| p.1).sum::<f32>() / n)
+        })
+        .collect();
+    let series = vec![
+        mprog::render::Series {
+            name: "train (50-step mean)".into(),
+            points: train,
+        },
+        mprog::render::Series {
+            name: "validation (EMA)".into(),
+            points: mprog::model::train::read_curve(&out.join("val.csv"), 1),
+        },
+    ];
+    let opts = mprog::render::PlotOptions {
+        log_y: true,
+        ..Default::default()
+    };
+    mprog::render::plot_lines(
+        &out.join("loss.png"),
+        "training loss",
+        "step",
+        "x0 MSE (normalised)",
+        &series,
+        &opts,
+    )
+    .map_err(|e| e.to_string())
 }

@@ -1,5 +1,5 @@
-//! The generated pages of the book (`book/src`): the library reference, the prompt card
-//! and one cookbook page per `programs/*.mprog` (the program is included by path, so the
+//! The generated pages of the book (`book/src`): the library reference, the prompt card,
+//! the reference tables ([`super::tables`]) and one cookbook page per `programs/*.mprog` (the program is included by path, so the
 //! file stays the one source), plus the cookbook list in `SUMMARY.md`. `mprog doc book`
 //! writes them; a test fails when the files differ from what this module generates.
 
@@ -166,6 +166,14 @@ pub fn pages(programs: &[ProgramFile], book_src: &Path) -> Vec<(PathBuf, String)
         (
             PathBuf::from("cookbook/README.md"),
             cookbook_index(programs),
+        ),
+        (
+            PathBuf::from(super::tables::OUTPUT_KINDS_PAGE),
+            super::tables::output_kinds_table(),
+        ),
+        (
+            PathBuf::from(super::tables::SOLVER_KNOBS_PAGE),
+            super::tables::solver_knobs_table(),
         ),
     ];
     for p in programs {

@@ -1,15 +1,10 @@
 //! BVH export of the 22-joint skeleton: in, a [`Motion`] (global joint positions); out, a BVH
 //! file whose forward kinematics reproduces those positions.
 //!
-//! * Rotations are solved from the positions with [`ik::chained_bone_rotations`]: every bone
-//!   gets its parent bone's rotation plus the minimal swing to its current direction; the
-//!   bones leaving the pelvis are oriented by the body's facing ([`ik::body_facing`]).
-//! * HIERARCHY: the 22 HumanML3D joints with their names, offsets = rest direction
-//!   ([`RAW_OFFSETS`]) × the motion's own bone length (mean over frames). BVH gives a joint one
-//!   rotation for all its children, while pelvis and spine3 have several bones leaving them
-//!   whose relative angles change over time; so each of those bones hangs from a zero-offset
-//!   connector joint (`pelvis_to_left_hip`, …, `spine3_to_right_collar`) that carries its
-//!   rotation. The pelvis itself carries the facing yaw; spine3 carries the neck bone.
+//! * HIERARCHY and rotations: the export rig ([`super::rig`]): the 22 HumanML3D joints with
+//!   their names, offsets = rest direction × the motion's own bone length (mean over
+//!   frames), zero-offset connector joints where bones branch, rotations solved from the
+//!   positions.
 //! * Channels: the root has `Xposition Yposition Zposition Zrotation Yrotation Xrotation`,
 //!   every other joint `Zrotation Yrotation Xrotation` (local rotation = Rz·Ry·Rx, degrees).
 //!   The root OFFSET is zero: its position channels are absolute.
@@ -20,11 +15,12 @@
 //!   (x, y, z) ↦ (x, −z, y)). A `#` comment after the `HIERARCHY` line states units, axes
 //!   and fps; Blender's importer skips it (it only looks for keywords there).
 
+use super::rig::{self, Node};
 use crate::features::FeatureError;
 use crate::features::ik::{self, Pose64};
 use crate::fsutil::write_atomic;
 use crate::motion::Motion;
-use crate::skeleton::{JOINT_NAMES, NUM_JOINTS, PARENTS, RAW_OFFSETS};
+use crate::skeleton::NUM_JOINTS;
 use glam::{DQuat, DVec3, EulerRot};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -88,83 +84,6 @@ pub fn write_bvh(path: &Path, m: &Motion, opts: &BvhExportOptions) -> Result<(),
     Ok(())
 }
 
-/// Where a BVH joint's global rotation comes from.
-#[derive(Clone, Copy, Debug)]
-enum Carry {
-    /// The body's facing yaw (the pelvis).
-    Facing,
-    /// The rotation of the bone ending at this HumanML3D joint.
-    Bone(usize),
-    /// The parent's rotation (leaves, which have no bone of their own).
-    Inherit,
-}
-
-/// One BVH joint: where it sits, what it is attached to, what drives its rotation.
-#[derive(Clone, Debug)]
-struct Node {
-    name: String,
-    parent: Option<usize>,
-    /// HumanML3D joint whose rest offset this node's OFFSET is (None: zero offset).
-    offset_of: Option<usize>,
-    carry: Carry,
-    children: Vec<usize>,
-}
-
-/// The BVH joints in file (depth-first) order.
-fn hierarchy() -> Vec<Node> {
-    let mut nodes = Vec::new();
-    add_joint(&mut nodes, 0, None, None);
-    nodes
-}
-
-fn push(nodes: &mut Vec<Node>, node: Node) -> usize {
-    let id = nodes.len();
-    if let Some(p) = node.parent {
-        nodes[p].children.push(id);
-    }
-    nodes.push(node);
-    id
-}
-
-/// Adds HumanML3D joint `j` under BVH node `parent`, then its subtree.
-fn add_joint(nodes: &mut Vec<Node>, j: usize, parent: Option<usize>, offset_of: Option<usize>) {
-    let children: Vec<usize> = (1..NUM_JOINTS).filter(|&c| PARENTS[c] == j).collect();
-    let carry = match (j, children.first()) {
-        (0, _) => Carry::Facing,
-        (_, Some(&first)) => Carry::Bone(first),
-        (_, None) => Carry::Inherit,
-    };
-    let name = JOINT_NAMES[j].to_string();
-    let id = push(
-        nodes,
-        Node {
-            name,
-            parent,
-            offset_of,
-            carry,
-            children: Vec::new(),
-        },
-    );
-    for (k, &c) in children.iter().enumerate() {
-        // The first child of a non-root joint uses the joint's own rotation; every other
-        // bone leaving a branching joint gets a connector carrying its rotation.
-        if j != 0 && k == 0 {
-            add_joint(nodes, c, Some(id), Some(c));
-        } else {
-            let name = format!("{}_to_{}", JOINT_NAMES[j], JOINT_NAMES[c]);
-            let node = Node {
-                name,
-                parent: Some(id),
-                offset_of: None,
-                carry: Carry::Bone(c),
-                children: Vec::new(),
-            };
-            let conn = push(nodes, node);
-            add_joint(nodes, c, Some(conn), Some(c));
-        }
-    }
-}
-
 /// The BVH text of `m`.
 pub fn bvh_string(m: &Motion, opts: &BvhExportOptions) -> Result<String, BvhExportError> {
     if m.is_empty() {
@@ -188,8 +107,8 @@ pub fn bvh_string(m: &Motion, opts: &BvhExportOptions) -> Result<String, BvhExpo
     };
     let poses = ik::poses_f64(m)?;
     let writer = Writer {
-        nodes: hierarchy(),
-        lengths: mean_bone_lengths(&poses),
+        nodes: rig::hierarchy(),
+        lengths: rig::mean_bone_lengths(&poses),
         scale: match opts.units {
             BvhUnits::Metres => 1.0,
             BvhUnits::Centimetres => 100.0,
@@ -249,17 +168,6 @@ pub fn resample_cubic(m: &Motion, fps: f32) -> Motion {
     Motion { frames, fps }
 }
 
-/// Mean length of every bone over the frames (index = child joint).
-fn mean_bone_lengths(poses: &[Pose64]) -> [f64; NUM_JOINTS] {
-    let mut len = [0.0; NUM_JOINTS];
-    for p in poses {
-        for j in 1..NUM_JOINTS {
-            len[j] += (p[j] - p[PARENTS[j]]).length() / poses.len() as f64;
-        }
-    }
-    len
-}
-
 fn write_header(out: &mut String, m: &Motion, source_fps: f32, opts: &BvhExportOptions) {
     let units = match opts.units {
         BvhUnits::Metres => "metres",
@@ -299,17 +207,16 @@ struct Writer {
 }
 
 impl Writer {
-    /// `fraction` × the rest offset of HumanML3D joint `j`, in file units and axes.
-    fn offset(&self, j: usize, fraction: f64) -> DVec3 {
-        let raw = DVec3::from(RAW_OFFSETS[j].map(f64::from));
-        self.axes * raw * (self.lengths[j] * fraction * self.scale)
+    /// `fraction` × the rest offset of `node`, in file units and axes.
+    fn offset(&self, node: &Node, fraction: f64) -> DVec3 {
+        self.axes * rig::rest_offset(node, &self.lengths) * (fraction * self.scale)
     }
 
     /// Writes the HIERARCHY entry of node `id` and its subtree.
     fn node(&self, out: &mut String, id: usize, depth: usize) {
         let pad = "  ".repeat(depth);
         let node = &self.nodes[id];
-        let o = node.offset_of.map_or(DVec3::ZERO, |j| self.offset(j, 1.0));
+        let o = self.offset(node, 1.0);
         let kind = if node.parent.is_none() {
             "ROOT"
         } else {
@@ -328,7 +235,7 @@ impl Writer {
         }
         if node.children.is_empty() {
             // Leaves continue their bone by half its length (BVH needs an end site).
-            let e = self.offset(node.offset_of.unwrap_or(0), 0.5);
+            let e = self.offset(node, 0.5);
             let _ = writeln!(out, "{pad}  End Site\n{pad}  {{");
             let _ = writeln!(
                 out,
@@ -341,20 +248,9 @@ impl Writer {
 
     /// One MOTION line: root position, then every joint's local Z, Y, X rotation in degrees.
     fn frame(&self, out: &mut String, pose: &Pose64, frame: usize) -> Result<(), FeatureError> {
-        let facing = ik::body_facing(pose, frame)?;
-        let bones = ik::chained_bone_rotations(pose, frame, facing)?;
-        let to_file = |q: DQuat| self.axes * q * self.axes.inverse();
-        let mut global = vec![DQuat::IDENTITY; self.nodes.len()];
         let root = self.axes * pose[0] * self.scale;
         let _ = write!(out, "{:.6} {:.6} {:.6}", root.x, root.y, root.z);
-        for (id, node) in self.nodes.iter().enumerate() {
-            let parent = node.parent.map_or(DQuat::IDENTITY, |p| global[p]);
-            global[id] = match node.carry {
-                Carry::Facing => to_file(facing),
-                Carry::Bone(b) => to_file(bones[b]),
-                Carry::Inherit => parent,
-            };
-            let local = (parent.inverse() * global[id]).normalize();
+        for local in rig::local_rotations(&self.nodes, pose, frame, self.axes)? {
             let (z, y, x) = local.to_euler(EulerRot::ZYX);
             let _ = write!(
                 out,
@@ -372,24 +268,6 @@ impl Writer {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn hierarchy_has_the_22_joints_and_5_connectors() {
-        let nodes = hierarchy();
-        assert_eq!(nodes.len(), NUM_JOINTS + 5);
-        for name in JOINT_NAMES {
-            assert_eq!(nodes.iter().filter(|n| n.name == name).count(), 1, "{name}");
-        }
-        // Every joint node hangs (through at most one connector) from its HumanML3D parent.
-        for (id, n) in nodes.iter().enumerate().skip(1) {
-            let Some(j) = n.offset_of else { continue };
-            let mut p = n.parent.unwrap();
-            if nodes[p].offset_of.is_none() && p != 0 {
-                p = nodes[p].parent.unwrap();
-            }
-            assert_eq!(nodes[p].name, JOINT_NAMES[PARENTS[j]], "node {id}");
-        }
-    }
 
     #[test]
     fn cubic_resampling_keeps_frames_duration_and_straight_lines() {

@@ -1,19 +1,22 @@
 //! One door for motion files: [`read_motion`] and [`write_motion`] pick the format from
 //! the extension.
 //!
-//! | extension | read | write |
-//! | --- | --- | --- |
-//! | `.bvh` | [`super::bvh::import_bvh`], retargeted to 22 joints, 20 fps | [`super::bvh_export`], one person, [`BvhExportOptions`] |
-//! | `.npy` | `[N,22,3]`, `[P,N,22,3]` joints or `[N,263]` features; `meta` from the [`super::sidecar`] | `[N,22,3]` / `[P,N,22,3]` float32 |
-//! | `.json` | `mprog-motion` documents | same, with `meta` |
+//! | extension | read |
+//! | --- | --- |
+//! | `.bvh` | [`super::bvh::import_bvh`], retargeted to 22 joints, 20 fps |
+//! | `.npy` | `[N,22,3]`, `[P,N,22,3]` joints or `[N,263]` features; `meta` from the [`super::sidecar`] |
+//! | `.json` | `mprog-motion` documents |
+//!
+//! Writing goes through the table of output kinds ([`super::outputs`]).
 //!
 //! Motions come back at mprog's 20 fps: BVH is resampled on import, JSON at other
 //! rates is resampled here, `.npy` has no rate and is taken as 20 fps.
 
 use super::bvh::{BvhError, BvhImportOptions, import_bvh};
 use super::bvh_export::BvhExportOptions;
-use super::json::{JsonError, Meta, Person, read_json, write_json};
-use super::npy::{MotionFile, NpyArray, NpyError, read_motion_npy, write_joints_npy};
+use super::json::{JsonError, Meta, Person, read_json};
+use super::npy::{MotionFile, NpyArray, NpyError, read_motion_npy};
+use super::outputs::{OutputJob, extension_list, output_kind};
 use crate::motion::Motion;
 use crate::skeleton::FPS;
 use std::path::Path;
@@ -29,6 +32,9 @@ pub enum FormatError {
     Json(#[from] JsonError),
     #[error("{path}: {what}")]
     Unsupported { path: String, what: String },
+    /// A writer of the output table refused the motion (the message names the file).
+    #[error("{0}")]
+    Refused(String),
 }
 
 /// What [`read_motion`] found.
@@ -92,9 +98,10 @@ pub fn read_motion(path: &Path) -> Result<LoadedMotion, FormatError> {
     }
 }
 
-/// Writes motions (one per person) as `.npy`, `.json` or `.bvh` (one person, Y up,
-/// metres, the motion's frame rate); `meta` goes into JSON only, since `.npy` and BVH hold
-/// no free-form fields (see [`super::sidecar`] for `.npy`).
+/// Writes motions (one per person) as one file of any kind in the output table
+/// ([`super::outputs`]): `.npy`, `.json`, `.bvh` (one person, Y up, metres, the motion's
+/// frame rate), pictures or pages. Unlike [`super::outputs::write_outputs`] it writes no
+/// sidecar and never splits people into files.
 pub fn write_motion(path: &Path, motions: &[Motion], meta: &Meta) -> Result<(), FormatError> {
     write_motion_with(path, motions, meta, &BvhExportOptions::default())
 }
@@ -106,44 +113,33 @@ pub fn write_motion_with(
     meta: &Meta,
     bvh: &BvhExportOptions,
 ) -> Result<(), FormatError> {
-    // JSON would turn ∞/NaN into `null` and `.npy` would carry them: refuse instead.
-    for (p, m) in motions.iter().enumerate() {
-        if let Some(f) = m
-            .frames
-            .iter()
-            .position(|pose| !pose.iter().all(|v| v.is_finite()))
-        {
-            return Err(unsupported(
-                path,
-                format!(
-                    "person {} frame {f} has non-finite joint positions; nothing was written",
-                    p + 1
-                ),
-            ));
-        }
-    }
-    match extension(path).as_str() {
-        "npy" => Ok(write_joints_npy(path, motions)?),
-        "json" => Ok(write_json(path, &default_names(motions.to_vec()), meta)?),
-        "bvh" => match motions {
-            [one] => super::bvh_export::write_bvh(path, one, bvh)
-                .map_err(|e| unsupported(path, e.to_string())),
-            _ => Err(unsupported(
-                path,
-                format!(
-                    "a BVH file holds one skeleton but there are {} people; write one .bvh per person or use .json/.npy",
-                    motions.len()
-                ),
-            )),
-        },
-        other => Err(unsupported(
+    let kind = output_kind(path).map_err(|_| {
+        unsupported(
             path,
-            format!("cannot write `.{other}` files: expected .npy, .json or .bvh"),
-        )),
-    }
+            format!(
+                "cannot write `.{}` files: expected {}",
+                extension(path),
+                extension_list()
+            ),
+        )
+    })?;
+    let origin = path.display().to_string();
+    let title = path
+        .file_stem()
+        .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    let job = OutputJob {
+        people: motions,
+        meta,
+        title: &title,
+        bvh,
+    };
+    let bytes = (kind.encode)(&origin, &job).map_err(FormatError::Refused)?;
+    crate::fsutil::write_bytes_atomic(path, &bytes)
+        .map_err(|e| unsupported(path, format!("cannot write: {e}")))
 }
 
-fn default_names(motions: Vec<Motion>) -> Vec<Person> {
+/// People named `person 1`, `person 2`, … in order.
+pub(super) fn default_names(motions: Vec<Motion>) -> Vec<Person> {
     motions
         .into_iter()
         .enumerate()

@@ -26,8 +26,7 @@ pub const SKELETON_NAME: &str = "humanml3d-22";
 /// Longest motion a document may hold, in seconds (6 hours).
 pub const MAX_SECONDS: f64 = 6.0 * 3600.0;
 
-/// Free-form reproduction metadata.
-pub type Meta = serde_json::Map<String, serde_json::Value>;
+pub use crate::motion::Meta;
 
 /// The whole file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -249,6 +248,13 @@ pub fn read_json(path: &Path) -> Result<(Vec<Person>, Meta), JsonError> {
 /// Writes people and metadata as a `.json` motion file (atomically).
 pub fn write_json(path: &Path, people: &[Person], meta: &Meta) -> Result<(), JsonError> {
     let name = path.display().to_string();
+    let bytes = json_bytes(&name, people, meta)?;
+    crate::fsutil::write_bytes_atomic(path, &bytes)
+        .map_err(|source| JsonError::Write { path: name, source })
+}
+
+/// The bytes of the `.json` file [`write_json`] writes; `origin` names it in errors.
+pub fn json_bytes(origin: &str, people: &[Person], meta: &Meta) -> Result<Vec<u8>, JsonError> {
     let fps: Vec<f32> = people.iter().map(|p| p.motion.fps).collect();
     if people.is_empty() || fps.iter().any(|&f| f != fps[0]) {
         let message = format!(
@@ -256,14 +262,15 @@ pub fn write_json(path: &Path, people: &[Person], meta: &Meta) -> Result<(), Jso
             people.len()
         );
         return Err(JsonError::Invalid {
-            origin: name,
+            origin: origin.to_string(),
             message,
         });
     }
     let doc = MotionDocument::new(people, meta.clone());
-    crate::fsutil::write_atomic(path, |w| {
-        serde_json::to_writer(&mut *w, &doc).map_err(std::io::Error::other)?;
-        w.write_all(b"\n")
-    })
-    .map_err(|source| JsonError::Write { path: name, source })
+    let mut bytes = serde_json::to_vec(&doc).map_err(|e| JsonError::Write {
+        path: origin.to_string(),
+        source: std::io::Error::other(e),
+    })?;
+    bytes.push(b'\n');
+    Ok(bytes)
 }

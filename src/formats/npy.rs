@@ -262,13 +262,20 @@ pub fn read_motion_npy(path: &Path) -> Result<MotionFile, NpyError> {
 }
 
 /// Writes motions as `float32`: `[N, 22, 3]` for one, `[P, N, 22, 3]` for several
-/// (all the same length).
+/// (all the same length), atomically.
 pub fn write_joints_npy(path: &Path, motions: &[Motion]) -> Result<(), NpyError> {
     let name = path.display().to_string();
+    let bytes = joints_npy_bytes(&name, motions)?;
+    crate::fsutil::write_bytes_atomic(path, &bytes)
+        .map_err(|source| NpyError::Write { path: name, source })
+}
+
+/// The bytes of the `.npy` file [`write_joints_npy`] writes; `origin` names it in errors.
+pub fn joints_npy_bytes(origin: &str, motions: &[Motion]) -> Result<Vec<u8>, NpyError> {
     let lengths: Vec<usize> = motions.iter().map(Motion::len).collect();
     if motions.is_empty() || lengths.iter().any(|&l| l != lengths[0]) {
         return Err(NpyError::RaggedPeople {
-            path: name,
+            path: origin.to_string(),
             count: motions.len(),
             lengths,
         });
@@ -278,7 +285,8 @@ pub fn write_joints_npy(path: &Path, motions: &[Motion]) -> Result<(), NpyError>
         1 => vec![frames, NUM_JOINTS as u64, 3],
         p => vec![p as u64, frames, NUM_JOINTS as u64, 3],
     };
-    crate::fsutil::write_atomic(path, |w| {
+    let mut bytes = Vec::new();
+    let encode = |w: &mut Vec<u8>| -> std::io::Result<()> {
         let mut writer = npyz::WriteOptions::new()
             .default_dtype()
             .shape(&shape)
@@ -288,6 +296,10 @@ pub fn write_joints_npy(path: &Path, motions: &[Motion]) -> Result<(), NpyError>
             writer.extend(m.to_flat())?;
         }
         writer.finish()
-    })
-    .map_err(|source| NpyError::Write { path: name, source })
+    };
+    encode(&mut bytes).map_err(|source| NpyError::Write {
+        path: origin.to_string(),
+        source,
+    })?;
+    Ok(bytes)
 }

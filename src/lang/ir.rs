@@ -260,11 +260,11 @@ impl CostEstimate {
 impl Ir {
     /// Where each person starts: the default placements, `spacing` metres apart when the
     /// program declares one.
-    pub fn start_placements(&self) -> Vec<crate::solve::Placement> {
+    pub fn start_placements(&self) -> Vec<crate::scene::Placement> {
         let spacing = self
             .spacing
-            .map_or(crate::solve::DEFAULT_SPACING, |s| s as f32);
-        crate::solve::Placement::defaults(self.people, spacing)
+            .map_or(crate::scene::DEFAULT_SPACING, |s| s as f32);
+        crate::scene::Placement::defaults(self.people, spacing)
     }
 
     /// Frame indices of a domain for a motion of `f` frames.

@@ -94,15 +94,26 @@ fn compile_inner(
     }
 }
 
+/// A program's error is the sum of its statements' errors; its terms are the statements.
+impl crate::objective::MotionError for Program {
+    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
+        self.evaluate(joints).total
+    }
+
+    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
+        self.evaluate(joints).per_statement
+    }
+}
+
 impl Program {
     /// Constant geometry the program names (walls, targets, regions), in world
     /// coordinates, for pictures and the viewer.
-    pub fn overlays(&self) -> &[crate::render::Overlay] {
+    pub fn overlays(&self) -> &[crate::scene::Overlay] {
         &self.checked.overlays
     }
 
     /// Joint-pair contacts the program asks for, with their frames, for the viewer.
-    pub fn contacts(&self) -> &[crate::view::Contact] {
+    pub fn contacts(&self) -> &[crate::scene::Contact] {
         &self.checked.contacts
     }
 
@@ -200,7 +211,7 @@ impl Program {
     }
 
     /// Where each person starts (the `spacing` line, else the default placements).
-    pub fn placements(&self) -> Vec<crate::solve::Placement> {
+    pub fn placements(&self) -> Vec<crate::scene::Placement> {
         self.checked.ir.start_placements()
     }
 

@@ -173,14 +173,15 @@ fn training_learns_and_resumes_from_checkpoints() {
         interrupt: Default::default(),
         init_from: None,
         device: Device::flex(),
+        after_checkpoint: Some(mark_checkpoint),
     };
     let first = run(30).run(&|_, _, _| {}).unwrap();
     assert_eq!(first.step, 30);
     assert!(dir.path().join("ckpt/state.json").exists());
     assert!(dir.path().join("bundle/model.safetensors").exists());
     assert!(
-        dir.path().join("loss.png").exists(),
-        "the loss curves are plotted"
+        dir.path().join("hook.txt").exists(),
+        "the after-checkpoint hook ran"
     );
     let second = run(30).run(&|_, _, _| {}).unwrap();
     assert_eq!(second.step, 60, "resumed from step 30");
@@ -222,6 +223,7 @@ fn interrupted_training_saves_a_checkpoint_and_resumes() {
         interrupt: interrupt.clone(),
         init_from: None,
         device: Device::flex(),
+        after_checkpoint: None,
     };
     // Ctrl-C arrives during step 4, between checkpoints (every 10 steps).
     let stopped = run
@@ -280,6 +282,7 @@ fn a_new_run_can_start_from_a_bundle() {
         interrupt: Default::default(),
         init_from: init,
         device: Device::flex(),
+        after_checkpoint: None,
     };
     run(first.path(), None, 5).run(&|_, _, _| {}).unwrap();
     let second = tempfile::tempdir().unwrap();
@@ -316,6 +319,7 @@ fn a_run_with_input_skip_can_start_from_a_bundle_without_it() {
         interrupt: Default::default(),
         init_from: init,
         device: Device::flex(),
+        after_checkpoint: None,
     };
     run(first.path(), &config, None, 5)
         .run(&|_, _, _| {})
@@ -354,4 +358,9 @@ fn a_run_with_input_skip_can_start_from_a_bundle_without_it() {
         .run(&|_, _, _| {})
         .unwrap_err();
     assert!(err.to_string().contains("does not match"), "{err}");
+}
+
+/// A hook that leaves `hook.txt` in the run folder.
+fn mark_checkpoint(out: &std::path::Path) -> Result<(), String> {
+    std::fs::write(out.join("hook.txt"), "ran").map_err(|e| e.to_string())
 }

@@ -11,7 +11,7 @@
 //! <out>/bundle/            the EMA weights as a shippable model bundle (f16)
 //! <out>/loss.csv           step, train loss, learning rate, seconds
 //! <out>/val.csv            step, validation loss of the EMA weights
-//! <out>/loss.png           both curves, plotted at every checkpoint
+//! <out>/loss.png           both curves (plotted by the CLI after every checkpoint)
 //! ```
 //!
 //! A checkpoint is written whole into `ckpt.new/` and then swapped in by renames, so a
@@ -306,6 +306,9 @@ fn batch_loss(
     loss
 }
 
+/// Run with the output folder after each checkpoint; an error is reported, not fatal.
+pub type CheckpointHook = fn(&Path) -> Result<(), String>;
+
 /// Everything a run needs besides the model.
 pub struct TrainRun<'a> {
     /// The data.
@@ -324,6 +327,8 @@ pub struct TrainRun<'a> {
     pub init_from: Option<PathBuf>,
     /// The device to train on (without autodiff; the run adds it).
     pub device: Device,
+    /// Called with the output folder after every checkpoint (the CLI plots `loss.png`).
+    pub after_checkpoint: Option<CheckpointHook>,
 }
 
 struct Checkpoint {
@@ -677,16 +682,19 @@ impl TrainRun<'_> {
                 &format!("{},{v},{:.1}\n", ck.state.step, ck.state.seconds),
             )?;
         }
-        // A picture of the curves; a plotting problem must not stop training.
-        if let Err(e) = plot_loss_curves(&self.out) {
-            eprintln!("warning: could not plot the loss curves: {e}");
+        // E.g. a picture of the curves; a plotting problem must not stop training.
+        if let Some(hook) = self.after_checkpoint
+            && let Err(e) = hook(&self.out)
+        {
+            eprintln!("warning: after the checkpoint: {e}");
         }
         self.save(ck, vocab)
     }
 }
 
-/// `(step, value)` pairs of column `col` of a CSV written by [`append`].
-fn read_curve(path: &Path, col: usize) -> Vec<(f32, f32)> {
+/// `(step, value)` pairs of column `col` of a CSV written by [`append`] (`loss.csv`,
+/// `val.csv`).
+pub fn read_curve(path: &Path, col: usize) -> Vec<(f32, f32)> {
     let Ok(text) = std::fs::read_to_string(path) else {
         return Vec::new();
     };
@@ -699,41 +707,6 @@ fn read_curve(path: &Path, col: usize) -> Vec<(f32, f32)> {
             Some((step, v))
         })
         .collect()
-}
-
-/// `<out>/loss.png`: training loss (mean over 50-step windows) and validation loss, log y.
-pub fn plot_loss_curves(out: &Path) -> Result<(), String> {
-    let raw = read_curve(&out.join("loss.csv"), 1);
-    let train: Vec<(f32, f32)> = raw
-        .chunks(50)
-        .map(|c| {
-            let n = c.len() as f32;
-            (c[c.len() - 1].0, c.iter().map(|p| p.1).sum::<f32>() / n)
-        })
-        .collect();
-    let series = vec![
-        crate::render::Series {
-            name: "train (50-step mean)".into(),
-            points: train,
-        },
-        crate::render::Series {
-            name: "validation (EMA)".into(),
-            points: read_curve(&out.join("val.csv"), 1),
-        },
-    ];
-    let opts = crate::render::PlotOptions {
-        log_y: true,
-        ..Default::default()
-    };
-    crate::render::plot_lines(
-        &out.join("loss.png"),
-        "training loss",
-        "step",
-        "x0 MSE (normalised)",
-        &series,
-        &opts,
-    )
-    .map_err(|e| e.to_string())
 }
 
 fn append(path: &Path, header: &str, rows: &str) -> Result<(), TrainError> {

@@ -126,7 +126,7 @@ pub fn render_gif(people: &[Motion], opts: &RenderOptions, path: &Path) -> Resul
 }
 
 /// The GIF file's bytes.
-pub(crate) fn gif_bytes(people: &[Motion], opts: &RenderOptions) -> Result<Vec<u8>, RenderError> {
+pub fn gif_bytes(people: &[Motion], opts: &RenderOptions) -> Result<Vec<u8>, RenderError> {
     let scene = Scene::new(people, opts)?;
     let frames = gif_frames(scene.len, opts)?;
     let delays = gif_delays(&frames, scene.fps, opts.frame_step)?;

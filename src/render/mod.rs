@@ -56,11 +56,11 @@ mod test_util;
 #[cfg(test)]
 mod tests;
 
-pub use animate::render_gif;
+pub use animate::{gif_bytes, render_gif};
 pub use error::RenderError;
 pub use options::{Overlay, RenderOptions, StripFrames};
 pub use plot::{PlotOptions, Series, plot_lines};
-pub use strip::render_strip_png;
+pub use strip::{render_strip_png, strip_bytes};
 
 use crate::motion::Motion;
 use std::path::Path;

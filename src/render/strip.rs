@@ -108,7 +108,7 @@ pub fn render_strip_png(
 }
 
 /// The strip PNG file's bytes.
-pub(crate) fn strip_bytes(people: &[Motion], opts: &RenderOptions) -> Result<Vec<u8>, RenderError> {
+pub fn strip_bytes(people: &[Motion], opts: &RenderOptions) -> Result<Vec<u8>, RenderError> {
     let scene = Scene::new(people, opts)?;
     let frames = strip_frames(scene.len, opts)?;
     let layout = Layout::new(&scene, frames.len(), opts.strip_width)?;

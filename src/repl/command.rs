@@ -35,11 +35,12 @@ pub enum Command {
     Grad(String),
     /// `:score`: the program's per-statement errors on the current motion.
     Score,
-    /// `:render out.gif|png`.
+    /// `:render out.gif|png`: a picture of the current motion (any output kind).
     Render(PathBuf),
-    /// `:view out.html`: the 3-D viewer page of the current motion.
+    /// `:view out.html`: the 3-D viewer page of the current motion (any output kind).
     View(PathBuf),
-    /// `:save FILE`: the program (`.mprog`) or the current motion (`.bvh`, `.npy`, `.json`).
+    /// `:save FILE`: the program (`.mprog`) or the current motion, as any kind of the
+    /// output table ([`crate::formats::outputs::OUTPUT_KINDS`]).
     Save(PathBuf),
     /// `:show`: print the session's program.
     Show,
@@ -106,7 +107,7 @@ pub const COMMANDS: &[CommandDoc] = &[
         "run",
         &[],
         "[SOLVER] [SEED] [KNOB=VALUE …]",
-        "solve the session's program with the model (guide, latent, lbfgs, ik, ik-reg, plain; default guide, seed 1); the result becomes the current motion",
+        "solve the session's program with the model (`:help run` lists the solvers and their knobs; default guide, seed 1); the result becomes the current motion",
     ),
     doc(
         "eval",
@@ -141,8 +142,8 @@ pub const COMMANDS: &[CommandDoc] = &[
     doc(
         "save",
         &["w"],
-        "FILE.mprog | OUT.bvh | OUT.npy | OUT.json",
-        "write the session's program, or the current motion (with the program, scores and geometry in its meta)",
+        "FILE.mprog | OUT",
+        "write the session's program, or the current motion as any output kind (listed below; with the program, scores and geometry in its meta)",
     ),
     doc(
         "show",

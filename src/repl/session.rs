@@ -11,13 +11,13 @@ use super::command::{self, Command, Input};
 use super::probe;
 use super::reply::{Item, Reply};
 use crate::features::recover_from_ric;
-use crate::formats::{LoadedMotion, read_motion};
+use crate::formats::bvh_export::BvhExportOptions;
+use crate::formats::{LoadedMotion, OutputJob, read_motion, write_outputs};
 use crate::lang::{Diagnostics, Program, Severity, compile};
 use crate::model::ModelBundle;
 use crate::model::generate::{GenerateRequest, generate};
 use crate::model::sampler::SamplerKind;
 use crate::motion::Motion;
-use crate::render::{RenderOptions, render_to_path};
 use crate::skeleton::FPS;
 use crate::solve::cleanup::{FootCleanup, clean_generated};
 use crate::solve::{Prior, SolveRequest, Solver, solve};
@@ -96,8 +96,7 @@ impl Session {
             Command::Eval(text) => probe::eval(self, &text),
             Command::Grad(text) => probe::grad(self, &text),
             Command::Score => probe::score(self),
-            Command::Render(path) => self.render(&path),
-            Command::View(path) => self.view(&path),
+            Command::Render(path) | Command::View(path) => self.export(&path),
             Command::Save(path) => self.save(&path),
             Command::Show => Reply::text(self.show()),
             Command::Drop { first, last } => self.drop_lines(first, last),
@@ -300,7 +299,8 @@ impl Session {
         };
         let Some(mut solver) = Solver::by_name(name) else {
             return Reply::error(format!(
-                "unknown solver `{name}`; use guide, latent, lbfgs, ik, ik-reg or plain"
+                "unknown solver `{name}`; use {}",
+                Solver::names().join(", ")
             ));
         };
         for (k, v) in knobs {
@@ -349,28 +349,31 @@ impl Session {
     }
 
     fn save(&self, path: &Path) -> Reply {
-        let ext = path
+        let is_program = path
             .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        if ext == "mprog" {
-            if self.program.trim().is_empty() {
-                return Reply::error("the program is empty: nothing to save");
-            }
-            let mut text = self.program.clone();
-            if !text.ends_with('\n') {
-                text.push('\n');
-            }
-            return match crate::fsutil::write_bytes_atomic(path, text.as_bytes()) {
-                Ok(()) => Reply::text(format!("wrote {}", path.display())),
-                Err(e) => Reply::error(format!("cannot write {}: {e}", path.display())),
-            };
+            .is_some_and(|e| e.eq_ignore_ascii_case("mprog"));
+        if !is_program {
+            return self.export(path);
         }
-        if !matches!(ext.as_str(), "bvh" | "npy" | "json") {
-            return Reply::error(format!(
-                "cannot save {}: use .mprog (the program), or .bvh, .npy or .json (the motion); `:render` writes pictures and `:view` pages",
-                path.display()
-            ));
+        if self.program.trim().is_empty() {
+            return Reply::error("the program is empty: nothing to save");
+        }
+        let mut text = self.program.clone();
+        if !text.ends_with('\n') {
+            text.push('\n');
+        }
+        match crate::fsutil::write_bytes_atomic(path, text.as_bytes()) {
+            Ok(()) => Reply::text(format!("wrote {}", path.display())),
+            Err(e) => Reply::error(format!("cannot write {}: {e}", path.display())),
+        }
+    }
+
+    /// Writes the current motion as any output kind (`:save`, `:render`, `:view`), with
+    /// the program's timeline and geometry in its meta and titled with where the motion
+    /// came from (after `:gen` the program's prompt is not what was generated).
+    fn export(&self, path: &Path) -> Reply {
+        if let Err(e) = crate::formats::output_kind(path) {
+            return Reply::error(format!("{e} (or .mprog for the program)"));
         }
         let Some(m) = &self.motion else {
             return Reply::error(NO_MOTION);
@@ -380,43 +383,21 @@ impl Session {
             Err(e) => return Reply::error(e),
         };
         meta.insert("origin".into(), m.origin.clone().into());
-        let bvh = crate::formats::bvh_export::BvhExportOptions::default();
-        if let Err(e) = crate::formats::write_motion_with(path, &m.people, &meta, &bvh) {
-            return Reply::error(e.to_string());
-        }
-        if ext == "npy" {
-            // As `mprog run` does: the meta goes in a sidecar next to the array.
-            meta.insert("fps".into(), FPS.into());
-            if let Err(e) = crate::formats::write_sidecar_meta(path, &meta) {
-                return Reply::error(e.to_string());
-            }
-        }
-        Reply::text(format!("wrote {}", path.display()))
-    }
-
-    fn view(&self, path: &Path) -> Reply {
-        let Some(m) = &self.motion else {
-            return Reply::error(NO_MOTION);
+        let job = OutputJob {
+            people: &m.people,
+            meta: &meta,
+            title: &m.origin,
+            bvh: &BvhExportOptions::default(),
         };
-        let meta = match self.motion_meta(m) {
-            Ok(meta) => meta,
-            Err(e) => return Reply::error(e),
-        };
-        match crate::view::write_html(&m.people, &meta, &m.origin, path) {
-            Ok(()) => Reply::text(format!("wrote {}", path.display())),
+        match write_outputs(&[path.to_path_buf()], &job) {
+            Ok(written) => Reply::text(
+                written
+                    .iter()
+                    .map(|p| format!("wrote {}", p.display()))
+                    .collect::<Vec<_>>()
+                    .join("\n"),
+            ),
             Err(e) => Reply::error(e.to_string()),
-        }
-    }
-
-    fn render(&self, path: &Path) -> Reply {
-        let Some(m) = &self.motion else {
-            return Reply::error(NO_MOTION);
-        };
-        // Titled with where the motion came from: after `:gen` the program's prompt is not
-        // what was generated.
-        match render_to_path(&m.people, &RenderOptions::titled(&m.origin), path) {
-            Ok(()) => Reply::text(format!("wrote {}", path.display())),
-            Err(e) => Reply::error(format!("cannot render {}: {e}", path.display())),
         }
     }
 
@@ -506,6 +487,14 @@ pub fn real_errors(d: &Diagnostics) -> bool {
 fn help(topic: Option<&str>) -> Reply {
     if let Some(t) = topic {
         return match command::find(t) {
+            Some(c) if c.name == "run" => Reply::text(format!(
+                ":{} {}\n    {}{}\nSolvers:\n{}",
+                c.name,
+                c.args,
+                c.help,
+                aliases(c),
+                crate::solve::solvers_help()
+            )),
             Some(c) => Reply::text(format!(
                 ":{} {}\n    {}{}",
                 c.name,
@@ -524,6 +513,14 @@ fn help(topic: Option<&str>) -> Reply {
         let head = format!(":{} {}", c.name, c.args);
         s.push_str(&format!("  {head:34} {}{}\n", c.help, aliases(c)));
     }
+    s.push_str(&format!(
+        "Output kinds of :save, :render and :view, by extension:\n{}\n",
+        crate::formats::outputs::kinds_help()
+            .lines()
+            .map(|l| format!("  {l}"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    ));
     s.push_str(
         "Tab completes joints, functions, keywords and commands; history is kept between sessions.",
     );

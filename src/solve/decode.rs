@@ -4,8 +4,8 @@
 //! used where gradients go through more than the joints (latent, L-BFGS) and as the
 //! reference the fused host path ([`super::host`]) is tested against.
 
-use super::place::Placement;
 use crate::features::{FEATURE_DIM, denormalize, recover_from_ric_tensor};
+use crate::scene::Placement;
 use crate::skeleton::NUM_JOINTS;
 use burn::prelude::*;
 

@@ -24,7 +24,7 @@
 //! joints.
 
 use super::bones::CONTACT_HEIGHT;
-use crate::eval::metrics::SKATING_FEET;
+use crate::skeleton::FEET as SKATING_FEET;
 use crate::skeleton::{FPS, NUM_JOINTS};
 
 /// A toe sliding faster than this (m/s) at set-up is swinging, not planted.

@@ -107,6 +107,9 @@
 //! weights and frame counts, and stops moving a sample whose error is ≤ 0 (satisfied
 //! hinges). With a single keyframe distance it is OmniControl's step with an adaptive τ.
 
+use super::knobs::{Knob, knob};
+use super::solver::{Solver, SolverConfig, SolverSpec};
+use crate::model::sampler::SamplerKind;
 use super::SolveError;
 use super::host::{HEAD, HostObjective, TermGradients, check_shape, extract_head, insert_head};
 use super::request::{Phase, Progress};
@@ -143,7 +146,7 @@ pub(crate) const ROOT_COLUMNS: usize = 4;
 /// Largest change of one normalised feature in one Polyak iteration.
 pub const MAX_POLYAK_DELTA: f32 = 0.5;
 
-/// Settings of [`super::Solver::Guide`]; defaults are OmniControl's inference settings.
+/// Settings of `guide`; defaults are OmniControl's inference settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GuideConfig {
     /// DDPM steps (1000 = the full chain; fewer = respaced).
@@ -218,7 +221,7 @@ impl Default for GuideConfig {
 }
 
 impl GuideConfig {
-    pub(crate) fn validate(&self) -> Result<(), SolveError> {
+    fn check_settings(&self) -> Result<(), SolveError> {
         if !(1..=DIFFUSION_STEPS).contains(&self.steps) {
             return Err(SolveError::Invalid(format!(
                 "guide: {} steps; use 1..={DIFFUSION_STEPS}",
@@ -298,7 +301,7 @@ impl GuideConfig {
 }
 
 /// Runs the guided chain.
-pub(crate) fn run(
+fn run(
     ctx: &Ctx,
     cfg: &GuideConfig,
     progress: &mut dyn FnMut(Progress),
@@ -647,4 +650,64 @@ pub fn smooth_over_frames(v: &[f32], frames: usize, width: usize, sigma: f32) ->
         }
     }
     out
+}
+
+/// `guide`, for [`super::registry`].
+pub const SPECS: &[SolverSpec] = &[SolverSpec {
+    name: "guide",
+    summary: "the posterior mean μ_t, K gradient steps at every DDPM step (OmniControl)",
+    make: || Solver::new(GuideConfig::default()),
+}];
+
+impl SolverConfig for GuideConfig {
+    const KNOBS: &'static [Knob<Self>] = &[
+        knob!(Count, "steps", "DDPM steps (fewer = respaced chain, faster, rougher)", steps),
+        knob!(Count, "k_early", "gradient iterations per step before the last `late_steps`", k_early),
+        knob!(Count, "k_late", "gradient iterations per step during the last `late_steps`", k_late),
+        knob!(Count, "late_steps", "T_s: the last steps that get `k_late` iterations and the late-step additions", late_steps),
+        knob!(Real, "tau", "OmniControl's strength τ", tau),
+        knob!(
+            Flag("OmniControl's plain inner loop", "keep bone lengths"),
+            "skeleton",
+            "1: the last `late_steps` optimise through the skeleton (bone lengths kept, planted feet kept on the floor); 0: OmniControl's plain inner loop",
+            keep_skeleton
+        ),
+        knob!(
+            Flag("off", "first frame frozen"),
+            "freeze",
+            "1: zero the gradient of frame 0, as OmniControl's reference code does",
+            freeze_first_frame
+        ),
+        knob!(Real, "smooth", "σ in frames of the Gaussian each late step's gradient is smoothed with over time; 0: OmniControl's raw gradient", smooth_frames),
+        knob!(Real, "feet", "weight of the slide penalty on planted toes in the last `late_steps`; 0: off", foot_lock),
+        knob!(
+            Flag("every column", "root columns only before the late steps"),
+            "early_root",
+            "1: before the last `late_steps`, step only the root columns (the path) and leave the pose to the model; 0: every column from the first step, as OmniControl",
+            early_root_only
+        ),
+        knob!(
+            Flag("one step for the whole error", "a step per statement"),
+            "split",
+            "1: in the last `late_steps`, each statement gets its own step size and the iteration steps along their sum; 0: one step for the whole error, as OmniControl",
+            split_terms
+        ),
+        knob!(Real, "late_root", "share of the root columns (path) in each step of the last `late_steps`, 0–1: the late steps meet contacts and keyframes with the pose instead of by moving the people; 1: OmniControl's plain gradient", late_root_scale),
+    ];
+
+    fn name(&self) -> &'static str {
+        "guide"
+    }
+
+    fn unguided(&self) -> SamplerKind {
+        SamplerKind::Ddpm(self.steps)
+    }
+
+    fn validate(&self) -> Result<(), SolveError> {
+        self.check_settings()
+    }
+
+    fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
+        run(ctx, self, progress)
+    }
 }

@@ -18,10 +18,10 @@
 use super::bones::SkeletonProjection;
 use super::decode::Decoder;
 use super::feet::FootLock;
-use super::place::Placement;
 use super::run::host;
 use super::{MotionError, SolveError};
 use crate::features::layout::RIC;
+use crate::scene::Placement;
 use crate::skeleton::NUM_JOINTS;
 use burn::prelude::*;
 

@@ -11,6 +11,8 @@
 //! Only the 67 columns that reach the joints get gradient from the error; the regulariser
 //! smooths every column. The error and its gradient go through the fused host path.
 
+use super::knobs::{Knob, KnobKind, knob};
+use super::solver::{Solver, SolverConfig, SolverSpec};
 use super::SolveError;
 use super::adam::Adam;
 use super::host::{extract_head, insert_head};
@@ -19,7 +21,7 @@ use super::run::{Ctx, Outcome, check_kind, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
 use crate::model::sampler::SamplerKind;
 
-/// Settings of [`super::Solver::Ik`].
+/// Settings of `ik`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IkConfig {
     /// The unguided sampler the motion starts from (DDIM-100).
@@ -51,7 +53,7 @@ impl IkConfig {
         }
     }
 
-    pub(crate) fn validate(&self) -> Result<(), SolveError> {
+    fn check_settings(&self) -> Result<(), SolveError> {
         check_kind(self.sampler)?;
         if !(self.lr.is_finite()
             && self.lr >= 0.0
@@ -91,7 +93,7 @@ pub fn add_smoothness(x: &[f32], frames: usize, lambda: f32, grad: &mut [f32]) -
 }
 
 /// Runs the unguided sample and the optimisation.
-pub(crate) fn run(
+fn run(
     ctx: &Ctx,
     cfg: &IkConfig,
     progress: &mut dyn FnMut(Progress),
@@ -127,4 +129,52 @@ pub(crate) fn run(
         relax: None,
         trace,
     })
+}
+
+/// `ik` and `ik-reg` (the same solver, with and without the regulariser), for
+/// [`super::registry`].
+pub const SPECS: &[SolverSpec] = &[
+    SolverSpec {
+        name: "ik",
+        summary: "the unguided sample's features directly, Adam (PMG's IK baseline)",
+        make: || Solver::new(IkConfig::ik()),
+    },
+    SolverSpec {
+        name: "ik-reg",
+        summary: "as `ik`, plus a frame-difference regulariser (PMG's IK+Reg baseline)",
+        make: || Solver::new(IkConfig::ik_reg()),
+    },
+];
+
+impl SolverConfig for IkConfig {
+    const KNOBS: &'static [Knob<Self>] = &[
+        Knob {
+            name: "ddim_steps",
+            doc: "steps of the unguided DDIM sample the optimisation starts from",
+            kind: KnobKind::Count,
+            get: |c| match c.sampler {
+                SamplerKind::Ddim(n) | SamplerKind::Ddpm(n) => n as f64,
+            },
+            set: |c, v| c.sampler = SamplerKind::Ddim(v as usize),
+        },
+        knob!(Count, "iterations", "Adam iterations on the features", iterations),
+        knob!(Real, "lr", "Adam's learning rate (PMG's 0.005 barely moves our normalised features; the benchmark uses 0.05)", lr),
+        knob!(Real, "smoothness", "λ of the frame-difference regulariser; > 0 is `ik-reg`", smoothness),
+    ];
+
+    fn name(&self) -> &'static str {
+        if self.smoothness > 0.0 { "ik-reg" } else { "ik" }
+    }
+
+    fn unguided(&self) -> SamplerKind {
+        self.sampler
+    }
+
+    fn validate(&self) -> Result<(), SolveError> {
+        self.check_settings()
+    }
+
+    fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
+        run(ctx, self, progress)
+    }
 }

@@ -35,10 +35,13 @@
 //! identical errors) for about one extra forward pass per iteration (measured 1.3–1.8×
 //! slower on a loaded 2-core machine).
 
+use super::knobs::{Knob, KnobKind, knob};
+use super::solver::{Solver, SolverConfig, SolverSpec};
+use crate::model::sampler::SamplerKind;
 use super::adam::Adam;
 use super::decode::RigidTensors;
 use super::host::{extract_head, insert_head};
-use super::place::Placement;
+use crate::scene::Placement;
 use super::reference::ReferencePull;
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
@@ -58,7 +61,7 @@ pub enum Relax {
     RigidXz,
 }
 
-/// Settings of [`super::Solver::Latent`]; defaults are PMG's.
+/// Settings of `latent`; defaults are PMG's.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LatentConfig {
     /// DDIM steps (100).
@@ -100,7 +103,7 @@ impl Default for LatentConfig {
 }
 
 impl LatentConfig {
-    pub(crate) fn validate(&self) -> Result<(), SolveError> {
+    fn check_settings(&self) -> Result<(), SolveError> {
         if !(1..=DIFFUSION_STEPS).contains(&self.ddim_steps) || self.iterations == 0 {
             return Err(SolveError::Invalid(format!(
                 "latent: {} DDIM steps and {} iterations; use 1..={DIFFUSION_STEPS} steps and ≥ 1 iteration",
@@ -176,7 +179,7 @@ pub fn frozen(model: &Mdm, autodiff: &Device) -> Mdm {
 }
 
 /// Runs the optimisation.
-pub(crate) fn run(
+fn run(
     ctx: &Ctx,
     cfg: &LatentConfig,
     progress: &mut dyn FnMut(Progress),
@@ -331,4 +334,59 @@ pub(crate) fn run(
         relax,
         trace,
     })
+}
+
+/// `latent`, for [`super::registry`].
+pub const SPECS: &[SolverSpec] = &[SolverSpec {
+    name: "latent",
+    summary: "the initial noise z of a DDIM chain, Adam through the whole chain (PMG)",
+    make: || Solver::new(LatentConfig::default()),
+}];
+
+impl SolverConfig for LatentConfig {
+    const KNOBS: &'static [Knob<Self>] = &[
+        knob!(Count, "ddim_steps", "length of the DDIM chain the gradient goes through", ddim_steps),
+        knob!(Count, "iterations", "Adam iterations on z (the last forward pass is returned)", iterations),
+        knob!(Real, "lr", "Adam's learning rate on z", lr),
+        Knob {
+            name: "relax",
+            doc: "1: also optimise a rigid horizontal move of each person (PMG §3.4)",
+            kind: KnobKind::Flag {
+                off: "off",
+                on: "rigid XZ",
+            },
+            get: |c| if c.relax == Relax::RigidXz { 1.0 } else { 0.0 },
+            set: |c, v| {
+                c.relax = if v != 0.0 {
+                    Relax::RigidXz
+                } else {
+                    Relax::None
+                }
+            },
+        },
+        knob!(
+            Flag("off", "keep bone lengths"),
+            "skeleton",
+            "1: measure and return the chain's output with the skeleton restored, also with `relax=1`; 0: PMG's raw output",
+            keep_skeleton
+        ),
+        knob!(Real, "ref_root", "weight of PMG's pull of the root columns (yaw and XZ velocity, height) towards the iteration-0 sample; 0: off", ref_root),
+        knob!(Real, "ref_legs", "weight of the same pull on the legs' columns (hips, knees, ankles, toes; foot contacts); 0: off", ref_legs),
+    ];
+
+    fn name(&self) -> &'static str {
+        "latent"
+    }
+
+    fn unguided(&self) -> SamplerKind {
+        SamplerKind::Ddim(self.ddim_steps)
+    }
+
+    fn validate(&self) -> Result<(), SolveError> {
+        self.check_settings()
+    }
+
+    fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
+        run(ctx, self, progress)
+    }
 }

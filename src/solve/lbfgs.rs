@@ -34,6 +34,9 @@
 //! every L-BFGS direction and line search stays in that subspace and the pose is left to
 //! the denoiser (HSC-1's walker keeps walking instead of standing with its hand up).
 
+use super::knobs::{Knob, knob};
+use super::solver::{Solver, SolverConfig, SolverSpec};
+use crate::model::sampler::SamplerKind;
 use super::SolveError;
 use super::guide::smooth_over_frames;
 use super::host::{HEAD, check_shape, extract_head, insert_head};
@@ -47,7 +50,7 @@ use burn::optim::{GradientsParams, LBFGSConfig, LineSearchFn};
 use burn::prelude::*;
 use std::cell::Cell;
 
-/// Settings of [`super::Solver::Lbfgs`].
+/// Settings of `lbfgs`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LbfgsConfig {
     /// DDPM steps (1000 = full chain).
@@ -95,7 +98,7 @@ impl Default for LbfgsConfig {
 }
 
 impl LbfgsConfig {
-    pub(crate) fn validate(&self) -> Result<(), SolveError> {
+    fn check_settings(&self) -> Result<(), SolveError> {
         if !(1..=DIFFUSION_STEPS).contains(&self.steps)
             || self.history == 0
             || self.max_iter == 0
@@ -135,7 +138,7 @@ struct Mu {
 }
 
 /// Runs the guided chain.
-pub(crate) fn run(
+fn run(
     ctx: &Ctx,
     cfg: &LbfgsConfig,
     progress: &mut dyn FnMut(Progress),
@@ -312,4 +315,52 @@ pub(crate) fn run(
         relax: None,
         trace,
     })
+}
+
+/// `lbfgs`, for [`super::registry`].
+pub const SPECS: &[SolverSpec] = &[SolverSpec {
+    name: "lbfgs",
+    summary: "the posterior mean μ_t with a fresh L-BFGS at every DDPM step (InterControl)",
+    make: || Solver::new(LbfgsConfig::default()),
+}];
+
+impl SolverConfig for LbfgsConfig {
+    const KNOBS: &'static [Knob<Self>] = &[
+        knob!(Count, "steps", "DDPM steps (fewer = respaced chain)", steps),
+        knob!(Count, "k_first", "L-BFGS `step` calls per denoising step before the last `late_steps`", k_first),
+        knob!(Count, "k_last", "`step` calls on each of the last `late_steps` (InterControl's 10; the smoothed late steps need more for one-frame targets)", k_last),
+        knob!(Count, "late_steps", "T_s", late_steps),
+        knob!(Count, "history", "L-BFGS history size", history),
+        knob!(Count, "max_iter", "inner iterations per `step` call", max_iter),
+        knob!(Real, "lr", "L-BFGS learning rate", lr),
+        knob!(
+            Flag("off", "keep bone lengths"),
+            "skeleton",
+            "1: the last `late_steps` optimise through the skeleton projection, as `guide` does; 0: InterControl's loop on the features",
+            keep_skeleton
+        ),
+        knob!(
+            Flag("every column", "root columns only before the late steps"),
+            "early_root",
+            "1: before the last `late_steps`, L-BFGS moves only the root columns, as `guide`'s early steps; 0: every column, as InterControl",
+            early_root_only
+        ),
+        knob!(Real, "smooth", "σ in frames of the Gaussian the late steps' edit is smoothed with over time; 0: InterControl's unsmoothed edit", smooth_frames),
+    ];
+
+    fn name(&self) -> &'static str {
+        "lbfgs"
+    }
+
+    fn unguided(&self) -> SamplerKind {
+        SamplerKind::Ddpm(self.steps)
+    }
+
+    fn validate(&self) -> Result<(), SolveError> {
+        self.check_settings()
+    }
+
+    fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
+        run(ctx, self, progress)
+    }
 }

@@ -8,11 +8,16 @@
 //!
 //! | solver | module | what is optimised | reference |
 //! | --- | --- | --- | --- |
-//! | [`Solver::Guide`] | [`guide`] | posterior mean μ_t, K gradient steps at every DDPM step | OmniControl spatial guidance (reference-algorithms §2.2) |
-//! | [`Solver::Latent`] | [`latent`] | initial noise z of a DDIM-100 chain, Adam through the chain | PMG (§1.1–1.3) |
-//! | [`Solver::Ik`] | [`ik`] | the unguided sample's normalised features, Adam, optional smoothness | PMG's IK / IK+Reg baselines (§5.2) |
-//! | [`Solver::Lbfgs`] | [`lbfgs`] | posterior mean μ_t, fresh L-BFGS at every DDPM step | InterControl IK guidance (§3.2) |
-//! | [`Solver::Plain`] | — | nothing (the unguided sampler, for comparisons) | — |
+//! | `guide` | [`guide`] | posterior mean μ_t, K gradient steps at every DDPM step | OmniControl spatial guidance (reference-algorithms §2.2) |
+//! | `latent` | [`latent`] | initial noise z of a DDIM-100 chain, Adam through the chain | PMG (§1.1–1.3) |
+//! | `ik`, `ik-reg` | [`ik`] | the unguided sample's normalised features, Adam, optional smoothness | PMG's IK / IK+Reg baselines (§5.2) |
+//! | `lbfgs` | [`lbfgs`] | posterior mean μ_t, fresh L-BFGS at every DDPM step | InterControl IK guidance (§3.2) |
+//! | `plain` | [`plain`] | nothing (the unguided sampler, for comparisons) | — |
+//!
+//! Each solver describes itself: its settings implement [`SolverConfig`] (knobs with their
+//! meaning and setter, validation, the run) and its module's `SPECS` give its name and
+//! defaults; [`registry`] lists them. A new solver is its file and one line in
+//! `registry!` below (`toy`, a test-only solver, shows the minimum).
 //!
 //! Many people: P prompts are sampled as one batch of B·P motions (sample-major: index
 //! `b·P + p`, CFG doubles it to 2·B·P), each person's joints are moved into the world by
@@ -33,7 +38,7 @@
 //!     let d = j.narrow(2, n - 1, 1).narrow(3, 0, 1) - target;
 //!     d.square().sum_dim(4).sqrt().reshape([b])
 //! };
-//! let req = SolveRequest::new(vec!["a person walks forward".into()], 120, 7, Solver::Guide(GuideConfig::default()));
+//! let req = SolveRequest::new(vec!["a person walks forward".into()], 120, 7, Solver::new(GuideConfig::default()));
 //! let out = solve(&Prior::from_bundle(&bundle), &req, &error, &device, |_| {})?;
 //! println!("error {:?} in {:.1} s", out.error, out.seconds);
 //! # Ok(()) }
@@ -44,64 +49,56 @@ pub mod bones;
 pub mod cleanup;
 mod decode;
 pub mod feet;
-pub mod guide;
 pub mod host;
-pub mod ik;
-pub mod latent;
-pub mod lbfgs;
-mod place;
+pub mod knobs;
 pub mod reference;
 mod request;
 mod run;
+mod solver;
+
+/// Declares the solver modules and [`registry`], which lists their [`SolverSpec`]s (each
+/// module's `SPECS`) in help order.
+macro_rules! registry {
+    ($($(#[$attr:meta])* $module:ident),* $(,)?) => {
+        $($(#[$attr])* pub mod $module;)*
+
+        /// Every solver: name, summary, defaults and (through them) knobs. The CLI, the
+        /// REPL, the benchmarks and the book read it.
+        pub fn registry() -> Vec<&'static SolverSpec> {
+            let mut all = Vec::new();
+            $($(#[$attr])* all.extend($module::SPECS.iter());)*
+            all
+        }
+    };
+}
+
+// A new solver is its file and one line here.
+registry! {
+    guide,
+    latent,
+    ik,
+    lbfgs,
+    plain,
+    #[cfg(test)]
+    toy,
+}
 
 #[cfg(test)]
 mod tests;
 
+pub use crate::scene::{DEFAULT_SPACING, Placement};
 pub use decode::{Decoder, RigidTensors};
 pub use guide::{GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;
+pub use knobs::{KnobKind, KnobValue};
 pub use latent::{LatentConfig, Relax};
 pub use lbfgs::LbfgsConfig;
-pub use place::{DEFAULT_SPACING, Placement};
-pub use request::{Phase, Prior, Progress, SolveRequest, SolveResult, Solver};
-pub use run::solve;
+pub use plain::PlainConfig;
+pub use request::{Phase, Prior, Progress, SolveRequest, SolveResult};
+pub use run::{Ctx, Outcome, solve};
+pub use solver::{Solver, SolverConfig, SolverSpec, solvers_help};
 
-use burn::tensor::Tensor;
-
-/// Differentiable error of a batch of motions: joints `[batch, people, frames, 22, 3]`
-/// (metres, Y up, world placement applied) → total error per sample `[batch]`.
-///
-/// Solvers minimise it. It must be built from burn tensor ops on the input's device so
-/// gradients reach the joints; it is called on plain and on autodiff devices. Closures
-/// `Fn(Tensor<5>) -> Tensor<1>` implement it.
-pub trait MotionError {
-    /// `[batch]` error of each sample.
-    fn error(&self, joints: Tensor<5>) -> Tensor<1>;
-
-    /// `[batch, terms]`: the error split into terms that sum to [`Self::error`] (a
-    /// program's statements). The guide sizes a step for each term on its own, so a stiff
-    /// term cannot set the pace of the others; one term by default.
-    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
-        self.error(joints).unsqueeze_dim(1)
-    }
-}
-
-/// A program's error is the sum of its statements' errors; its terms are the statements.
-impl MotionError for crate::lang::Program {
-    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
-        self.evaluate(joints).total
-    }
-
-    fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
-        self.evaluate(joints).per_statement
-    }
-}
-
-impl<F: Fn(Tensor<5>) -> Tensor<1>> MotionError for F {
-    fn error(&self, joints: Tensor<5>) -> Tensor<1> {
-        self(joints)
-    }
-}
+pub use crate::objective::MotionError;
 
 /// Why a solve failed.
 #[derive(Debug, thiserror::Error)]

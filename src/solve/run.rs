@@ -4,15 +4,15 @@
 
 use super::decode::Decoder;
 use super::host::{HostObjective, check_shape};
-use super::place::{DEFAULT_SPACING, Placement};
-use super::request::{Phase, Prior, Progress, SolveRequest, SolveResult, Solver};
-use super::{MotionError, SolveError, guide, ik, latent, lbfgs};
+use super::request::{Phase, Prior, Progress, SolveRequest, SolveResult};
+use super::{MotionError, SolveError};
 use crate::features::{FEATURE_DIM, recover_from_ric};
 use crate::model::Mdm;
 use crate::model::noise::NoiseSource;
 use crate::model::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::motion::Motion;
+use crate::scene::{DEFAULT_SPACING, Placement};
 use crate::skeleton::NUM_JOINTS;
 use burn::prelude::*;
 use std::time::Instant;
@@ -21,8 +21,8 @@ use std::time::Instant;
 /// `plain` solve reproduces `generate`).
 const STEP_NOISE: u64 = 0x5DEE_CE66;
 
-/// Everything a solver needs besides its own settings.
-pub(crate) struct Ctx<'a> {
+/// Everything a solver needs besides its own settings (see [`super::SolverConfig::run`]).
+pub struct Ctx<'a> {
     pub prior: Prior<'a>,
     pub error: &'a dyn MotionError,
     /// Plain (non-autodiff) device.
@@ -41,7 +41,7 @@ pub(crate) struct Ctx<'a> {
 }
 
 /// What a solver hands back: normalised samples and, when it relaxes, a transform per motion.
-pub(crate) struct Outcome {
+pub struct Outcome {
     /// `[B·P, N, 263]` normalised.
     pub x: Vec<f32>,
     /// Per motion, applied before the placement.
@@ -187,13 +187,7 @@ fn validate(prior: &Prior, req: &SolveRequest) -> Result<Vec<Placement>, SolveEr
     {
         return bad("a placement is not finite".into());
     }
-    match &req.solver {
-        Solver::Plain(k) => check_kind(*k)?,
-        Solver::Guide(c) => c.validate()?,
-        Solver::Latent(c) => c.validate()?,
-        Solver::Ik(c) => c.validate()?,
-        Solver::Lbfgs(c) => c.validate()?,
-    }
+    req.solver.validate()?;
     Ok(placements)
 }
 
@@ -235,17 +229,7 @@ pub fn solve(
         decoder: Decoder::new(prior.mean, prior.std, &placements),
     };
     let progress: &mut dyn FnMut(Progress) = &mut on_progress;
-    let out = match &req.solver {
-        Solver::Plain(kind) => Outcome {
-            x: host(ctx.sample_plain(*kind, progress)),
-            relax: None,
-            trace: Vec::new(),
-        },
-        Solver::Guide(c) => guide::run(&ctx, c, progress)?,
-        Solver::Latent(c) => latent::run(&ctx, c, progress)?,
-        Solver::Ik(c) => ik::run(&ctx, c, progress)?,
-        Solver::Lbfgs(c) => lbfgs::run(&ctx, c, progress)?,
-    };
+    let out = req.solver.run(&ctx, progress)?;
     ensure_finite(&out.x, req.solver.name(), "sample", || {
         "the end of the solve".into()
     })?;

@@ -51,7 +51,7 @@ impl ModuleMapper for Reinit {
     }
 }
 
-fn tiny_bundle() -> ModelBundle {
+pub(super) fn tiny_bundle() -> ModelBundle {
     let dev = Device::flex();
     let config = ModelConfig {
         features: FEATURE_DIM,
@@ -113,7 +113,7 @@ fn mean_shortfall(y: Tensor<5>, target: f32) -> Tensor<1> {
 }
 
 /// Left wrist above 1.6 m on every frame: mean hinge in metres.
-fn wrist_up(j: Tensor<5>) -> Tensor<1> {
+pub(super) fn wrist_up(j: Tensor<5>) -> Tensor<1> {
     mean_shortfall(joint(j, 20).narrow(4, 1, 1), 1.6)
 }
 
@@ -199,13 +199,13 @@ fn every_solver_beats_the_unguided_sample() {
     for (name, err) in errors {
         let plain_ddpm = run(
             &bundle,
-            &request(&["a person walks"], Solver::Plain(SamplerKind::Ddpm(1000))),
+            &request(&["a person walks"], Solver::plain(SamplerKind::Ddpm(1000))),
             &err,
         )
         .error[0];
         let plain_ddim = run(
             &bundle,
-            &request(&["a person walks"], Solver::Plain(SamplerKind::Ddim(8))),
+            &request(&["a person walks"], Solver::plain(SamplerKind::Ddim(8))),
             &err,
         )
         .error[0];
@@ -214,11 +214,11 @@ fn every_solver_beats_the_unguided_sample() {
             "{name}: unguided already solved"
         );
         let cases = [
-            (Solver::Guide(small_guide()), plain_ddpm),
-            (Solver::Latent(small_latent()), plain_ddim),
-            (Solver::Ik(small_ik(0.0)), plain_ddim),
-            (Solver::Ik(small_ik(0.1)), plain_ddim),
-            (Solver::Lbfgs(small_lbfgs()), plain_ddpm),
+            (Solver::new(small_guide()), plain_ddpm),
+            (Solver::new(small_latent()), plain_ddim),
+            (Solver::new(small_ik(0.0)), plain_ddim),
+            (Solver::new(small_ik(0.1)), plain_ddim),
+            (Solver::new(small_lbfgs()), plain_ddpm),
         ];
         for (solver, before) in cases {
             let label = solver.name();
@@ -242,7 +242,7 @@ fn every_solver_beats_the_unguided_sample() {
 #[test]
 fn latent_trace_starts_at_the_unguided_ddim_sample() {
     let bundle = tiny_bundle();
-    let req = request(&["a person walks"], Solver::Plain(SamplerKind::Ddim(8)));
+    let req = request(&["a person walks"], Solver::plain(SamplerKind::Ddim(8)));
     let plain = run(&bundle, &req, &pelvis_at_end);
     // Without the skeleton projection, which would measure a projected sample.
     let cfg = LatentConfig {
@@ -251,7 +251,7 @@ fn latent_trace_starts_at_the_unguided_ddim_sample() {
     };
     let latent = run(
         &bundle,
-        &request(&["a person walks"], Solver::Latent(cfg)),
+        &request(&["a person walks"], Solver::new(cfg)),
         &pelvis_at_end,
     );
     let first = latent.trace[0][0];
@@ -266,7 +266,7 @@ fn latent_trace_starts_at_the_unguided_ddim_sample() {
 fn plain_solve_reproduces_generate() {
     let bundle = tiny_bundle();
     let kind = SamplerKind::Ddpm(10);
-    let req = request(&["a person waves"], Solver::Plain(kind));
+    let req = request(&["a person waves"], Solver::plain(kind));
     let out = run(&bundle, &req, &pelvis_at_end);
     let gen_req = GenerateRequest {
         prompts: req.prompts.clone(),
@@ -284,20 +284,20 @@ fn plain_solve_reproduces_generate() {
 fn same_seed_gives_bit_identical_output() {
     let bundle = tiny_bundle();
     for solver in [
-        Solver::Guide(GuideConfig {
+        Solver::new(GuideConfig {
             steps: 20,
             k_late: 20,
             ..GuideConfig::default()
         }),
-        Solver::Latent(LatentConfig {
+        Solver::new(LatentConfig {
             iterations: 5,
             ..small_latent()
         }),
-        Solver::Ik(IkConfig {
+        Solver::new(IkConfig {
             iterations: 10,
             ..small_ik(0.1)
         }),
-        Solver::Lbfgs(LbfgsConfig {
+        Solver::new(LbfgsConfig {
             steps: 10,
             ..LbfgsConfig::default()
         }),
@@ -321,19 +321,19 @@ fn same_seed_gives_bit_identical_output() {
 fn nan_error_stops_with_a_clear_message() {
     let bundle = tiny_bundle();
     for solver in [
-        Solver::Guide(GuideConfig {
+        Solver::new(GuideConfig {
             steps: 5,
             ..GuideConfig::default()
         }),
-        Solver::Latent(LatentConfig {
+        Solver::new(LatentConfig {
             iterations: 3,
             ..small_latent()
         }),
-        Solver::Ik(IkConfig {
+        Solver::new(IkConfig {
             iterations: 3,
             ..small_ik(0.0)
         }),
-        Solver::Lbfgs(LbfgsConfig {
+        Solver::new(LbfgsConfig {
             steps: 5,
             ..LbfgsConfig::default()
         }),
@@ -365,12 +365,12 @@ fn two_people_touch_wrists() {
     let prompts = ["a person walks", "a person waves"];
     let before = run(
         &bundle,
-        &request(&prompts, Solver::Plain(SamplerKind::Ddpm(1000))),
+        &request(&prompts, Solver::plain(SamplerKind::Ddpm(1000))),
         &wrists_touch,
     );
     let d0 = wrist_distance(&before, 10);
     assert!(d0 > 0.5, "people start {d0} m apart");
-    for solver in [Solver::Guide(small_guide()), Solver::Latent(small_latent())] {
+    for solver in [Solver::new(small_guide()), Solver::new(small_latent())] {
         let out = run(&bundle, &request(&prompts, solver), &wrists_touch);
         let d = wrist_distance(&out, 10);
         eprintln!("{}: wrist distance {d0:.3} -> {d:.3}", out.trace.len());
@@ -391,7 +391,7 @@ fn relaxation_moves_the_motion_rigidly() {
     };
     let out = run(
         &bundle,
-        &request(&["a person walks"], Solver::Latent(cfg)),
+        &request(&["a person walks"], Solver::new(cfg)),
         &pelvis_at_end,
     );
     let p = out.placements[0][0];
@@ -408,7 +408,7 @@ fn bad_requests_are_refused() {
     let bundle = tiny_bundle();
     let prior = Prior::from_bundle(&bundle);
     let go = |req: SolveRequest| solve(&prior, &req, &pelvis_at_end, &Device::flex(), |_| {});
-    let plain = Solver::Plain(SamplerKind::Ddim(4));
+    let plain = Solver::plain(SamplerKind::Ddim(4));
     assert!(matches!(
         go(request(&[], plain.clone())),
         Err(SolveError::Invalid(_))
@@ -655,14 +655,14 @@ fn fused_and_graph_guidance_agree() {
     };
     let fused = run(
         &bundle,
-        &request(&["a person walks"], Solver::Guide(cfg.clone())),
+        &request(&["a person walks"], Solver::new(cfg.clone())),
         &pelvis_at_end,
     );
     let graph = run(
         &bundle,
         &request(
             &["a person walks"],
-            Solver::Guide(GuideConfig {
+            Solver::new(GuideConfig {
                 fused: false,
                 ..cfg
             }),
@@ -693,12 +693,12 @@ fn ik_reg_is_smoother_than_ik_and_guide_rules_differ_on_dense_errors() {
     };
     let ik = run(
         &bundle,
-        &request(&["a person walks"], Solver::Ik(small_ik(0.0))),
+        &request(&["a person walks"], Solver::new(small_ik(0.0))),
         &wrist_up,
     );
     let reg = run(
         &bundle,
-        &request(&["a person walks"], Solver::Ik(small_ik(0.1))),
+        &request(&["a person walks"], Solver::new(small_ik(0.1))),
         &wrist_up,
     );
     eprintln!("roughness ik {} ik-reg {}", roughness(&ik), roughness(&reg));
@@ -710,12 +710,12 @@ fn ik_reg_is_smoother_than_ik_and_guide_rules_differ_on_dense_errors() {
     };
     let g = run(
         &bundle,
-        &request(&["a person walks"], Solver::Guide(gradient)),
+        &request(&["a person walks"], Solver::new(gradient)),
         &wrist_up,
     );
     let p = run(
         &bundle,
-        &request(&["a person walks"], Solver::Guide(small_guide())),
+        &request(&["a person walks"], Solver::new(small_guide())),
         &wrist_up,
     );
     eprintln!("wrist: gradient rule {} polyak {}", g.error[0], p.error[0]);
@@ -731,14 +731,14 @@ fn checkpointed_latent_gradient_matches_the_full_graph() {
     };
     let a = run(
         &bundle,
-        &request(&["a person walks"], Solver::Latent(cfg.clone())),
+        &request(&["a person walks"], Solver::new(cfg.clone())),
         &pelvis_at_end,
     );
     let b = run(
         &bundle,
         &request(
             &["a person walks"],
-            Solver::Latent(LatentConfig {
+            Solver::new(LatentConfig {
                 checkpoint: false,
                 ..cfg
             }),
@@ -763,14 +763,10 @@ fn knobs_set_settings_and_unknown_ones_list_the_valid_names() {
     latent.set_knob("iterations", 30.0).unwrap();
     latent.set_knob("ddim_steps", 20.0).unwrap();
     latent.set_knob("relax", 1.0).unwrap();
-    match &latent {
-        Solver::Latent(c) => {
-            assert_eq!((c.iterations, c.ddim_steps), (30, 20));
-            assert_eq!(c.relax, Relax::RigidXz);
-        }
-        other => panic!("{other:?}"),
-    }
-    assert_eq!(latent.unguided(), Solver::Plain(SamplerKind::Ddim(20)));
+    let c = latent.config::<LatentConfig>().expect("latent settings");
+    assert_eq!((c.iterations, c.ddim_steps), (30, 20));
+    assert_eq!(c.relax, Relax::RigidXz);
+    assert_eq!(latent.unguided(), Solver::plain(SamplerKind::Ddim(20)));
     let err = latent.set_knob("k_late", 3.0).unwrap_err();
     assert!(
         err.contains("iterations") && err.contains("ddim_steps"),
@@ -780,7 +776,7 @@ fn knobs_set_settings_and_unknown_ones_list_the_valid_names() {
     assert!(latent.set_knob("lr", f64::NAN).is_err());
     let mut guide = Solver::by_name("guide").unwrap();
     guide.set_knob("steps", 100.0).unwrap();
-    assert_eq!(guide.unguided(), Solver::Plain(SamplerKind::Ddpm(100)));
+    assert_eq!(guide.unguided(), Solver::plain(SamplerKind::Ddpm(100)));
     let mut ik = Solver::by_name("ik").unwrap();
     ik.set_knob("smoothness", 0.1).unwrap();
     assert_eq!(ik.name(), "ik-reg");
@@ -827,7 +823,7 @@ fn check_keeps_the_skeleton(solver: impl Fn(bool) -> Solver) {
 #[test]
 fn guide_keeps_the_skeleton_in_its_late_steps() {
     check_keeps_the_skeleton(|keep_skeleton| {
-        Solver::Guide(GuideConfig {
+        Solver::new(GuideConfig {
             steps: 50,
             keep_skeleton,
             ..GuideConfig::default()
@@ -866,7 +862,7 @@ fn keyframe_jump(bundle: &ModelBundle, solver: Solver) -> f32 {
 fn smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
     let bundle = tiny_bundle();
     let guide = |smooth_frames| {
-        Solver::Guide(GuideConfig {
+        Solver::new(GuideConfig {
             steps: 50,
             smooth_frames,
             ..GuideConfig::default()
@@ -902,7 +898,7 @@ fn a_first_frame_target_is_met_unless_the_frame_is_frozen() {
         };
         run(
             &bundle,
-            &request(&["a person walks"], Solver::Guide(cfg)),
+            &request(&["a person walks"], Solver::new(cfg)),
             &wrist_up_at_start,
         )
     };
@@ -963,13 +959,13 @@ fn early_steps_steer_the_root_and_leave_the_pose_to_the_denoiser() {
         };
         run(
             &bundle,
-            &request(&["a person walks"], Solver::Guide(cfg)),
+            &request(&["a person walks"], Solver::new(cfg)),
             err,
         )
     };
     let plain = run(
         &bundle,
-        &request(&["a person walks"], Solver::Plain(SamplerKind::Ddpm(20))),
+        &request(&["a person walks"], Solver::plain(SamplerKind::Ddpm(20))),
         &wrist_up,
     );
     // A wrist height depends on pose columns only: root-only early steps cannot touch it.
@@ -985,7 +981,7 @@ fn early_steps_steer_the_root_and_leave_the_pose_to_the_denoiser() {
     // Where the pelvis ends depends on the root: root-only steps still steer it there.
     let plain_pelvis = run(
         &bundle,
-        &request(&["a person walks"], Solver::Plain(SamplerKind::Ddpm(20))),
+        &request(&["a person walks"], Solver::plain(SamplerKind::Ddpm(20))),
         &pelvis_at_end,
     );
     let steered = solve(true, &pelvis_at_end);
@@ -1051,7 +1047,7 @@ fn the_foot_lock_adds_its_gradient_but_not_its_value() {
 #[test]
 fn latent_keeps_the_skeleton() {
     check_keeps_the_skeleton(|keep_skeleton| {
-        Solver::Latent(LatentConfig {
+        Solver::new(LatentConfig {
             keep_skeleton,
             ..small_latent()
         })
@@ -1061,7 +1057,7 @@ fn latent_keeps_the_skeleton() {
 #[test]
 fn lbfgs_keeps_the_skeleton_in_its_late_steps() {
     check_keeps_the_skeleton(|keep_skeleton| {
-        Solver::Lbfgs(LbfgsConfig {
+        Solver::new(LbfgsConfig {
             steps: 30,
             keep_skeleton,
             ..LbfgsConfig::default()
@@ -1171,7 +1167,7 @@ fn a_stiff_statement_does_not_set_the_pace_of_the_others() {
         };
         run(
             &bundle,
-            &request(&["a person walks"], Solver::Guide(cfg)),
+            &request(&["a person walks"], Solver::new(cfg)),
             &StiffAndSoft,
         )
     };
@@ -1225,7 +1221,7 @@ fn late_root_scale_leaves_the_path_and_moves_the_pose() {
     let bundle = tiny_bundle();
     // Every step a late step, so the scale applies throughout.
     let guide = |late_root_scale| {
-        Solver::Guide(GuideConfig {
+        Solver::new(GuideConfig {
             steps: 20,
             late_steps: 20,
             k_late: 30,
@@ -1256,7 +1252,8 @@ fn late_root_scale_leaves_the_path_and_moves_the_pose() {
     );
     let mut knob = guide(1.0);
     knob.set_knob("late_root", 0.01).unwrap();
-    assert!(matches!(&knob, Solver::Guide(c) if c.late_root_scale == 0.01));
+    let c = knob.config::<GuideConfig>().expect("guide settings");
+    assert_eq!(c.late_root_scale, 0.01);
     knob.set_knob("late_root", 1.5).unwrap();
     assert_refused(&bundle, knob, "late_root");
 }
@@ -1272,7 +1269,7 @@ fn lbfgs_early_root_steps_leave_the_pose_to_the_model() {
     let bundle = tiny_bundle();
     // No late steps: every step is an early one.
     let lbfgs = |early_root_only| {
-        Solver::Lbfgs(LbfgsConfig {
+        Solver::new(LbfgsConfig {
             steps: 10,
             late_steps: 0,
             early_root_only,
@@ -1299,7 +1296,7 @@ fn lbfgs_early_root_steps_leave_the_pose_to_the_model() {
 fn lbfgs_smoothing_spreads_a_keyframe_edit_over_its_neighbours() {
     let bundle = tiny_bundle();
     let lbfgs = |smooth_frames| {
-        Solver::Lbfgs(LbfgsConfig {
+        Solver::new(LbfgsConfig {
             steps: 30,
             smooth_frames,
             ..LbfgsConfig::default()
@@ -1324,7 +1321,7 @@ fn the_reference_pull_keeps_the_legs_near_the_first_sample() {
     let bundle = tiny_bundle();
     let first = run(
         &bundle,
-        &request(&["a person walks"], Solver::Plain(SamplerKind::Ddim(8))),
+        &request(&["a person walks"], Solver::plain(SamplerKind::Ddim(8))),
         &pelvis_at_end,
     );
     let legs = leg_columns();
@@ -1344,7 +1341,7 @@ fn the_reference_pull_keeps_the_legs_near_the_first_sample() {
         };
         run(
             &bundle,
-            &request(&["a person walks"], Solver::Latent(cfg)),
+            &request(&["a person walks"], Solver::new(cfg)),
             &pelvis_at_end,
         )
     };
@@ -1364,7 +1361,7 @@ fn the_reference_pull_keeps_the_legs_near_the_first_sample() {
     assert!(pulled.error[0] < 0.8 * pulled.trace[0][0]);
     // The pull is not part of the reported error: both traces start at the same sample.
     assert_eq!(free.trace[0], pulled.trace[0]);
-    let negative = Solver::Latent(LatentConfig {
+    let negative = Solver::new(LatentConfig {
         ref_root: -1.0,
         ..small_latent()
     });

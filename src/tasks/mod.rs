@@ -15,8 +15,8 @@ pub mod keyframe;
 pub mod report;
 pub mod suite;
 
-use crate::eval::metrics::{foot_skating_ratio, max_acceleration, max_bone_error};
 use crate::features::FEATURE_DIM;
+use crate::metrics::per_motion::{foot_skating_ratio, max_acceleration, max_bone_error};
 use crate::motion::Motion;
 use crate::solve::{Prior, Progress, SolveRequest, Solver, solve};
 use burn::prelude::*;

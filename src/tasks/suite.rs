@@ -3,8 +3,7 @@
 use super::keyframe::{CONTROLLED, Density, KeyframeGoal};
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
 use crate::lang::Program;
-use crate::model::sampler::SamplerKind;
-use crate::solve::{GuideConfig, IkConfig, LatentConfig, LbfgsConfig, MotionError, Solver};
+use crate::solve::{MotionError, Solver};
 use burn::prelude::*;
 use std::path::Path;
 
@@ -252,46 +251,71 @@ pub enum SolverSettings {
     Paper,
 }
 
-/// The solvers compared, with the benchmark's settings.
-pub fn solvers(settings: SolverSettings) -> Vec<Solver> {
-    if settings == SolverSettings::Paper {
-        return ["plain", "guide", "latent", "ik", "ik-reg", "lbfgs"]
-            .iter()
-            .map(|n| Solver::by_name(n).expect("known solver"))
-            .collect();
-    }
+/// Knobs of the fast settings, by solver: `(solver, knob, value)`. A solver with no row
+/// runs with its defaults.
+pub const FAST_KNOBS: &[(&str, &str, f64)] = &[
+    ("plain", "steps", 100.0),
+    ("guide", "steps", 100.0),
+    ("guide", "k_late", 50.0),
+    ("guide", "late_steps", 5.0),
+    // 60 iterations, the cookbook's: with step 8,704, 30 left Fig. 1 0.105 off and 60
+    // 0.0004 (the solvers chapter); at 10, step 6,550 left HSC-1 0.11 off (task notes).
+    ("latent", "ddim_steps", 10.0),
+    ("latent", "iterations", 60.0),
+    ("latent", "lr", 0.02),
     // PMG's lr 0.005 hardly moves the constraint error of our normalised features in 100
     // iterations; 0.05 reaches the other solvers' error, which the comparison needs.
-    let ik = IkConfig {
-        sampler: SamplerKind::Ddim(10),
-        iterations: 100,
-        lr: 0.05,
-        ..IkConfig::ik()
-    };
-    vec![
-        Solver::Plain(SamplerKind::Ddpm(100)),
-        Solver::Guide(GuideConfig {
-            steps: 100,
-            k_late: 50,
-            late_steps: 5,
-            ..GuideConfig::default()
-        }),
-        // 60 iterations, the cookbook's: with step 8,704, 30 left Fig. 1 0.105 off and 60
-        // 0.0004 (the solvers chapter); at 10, step 6,550 left HSC-1 0.11 off (task notes).
-        Solver::Latent(LatentConfig {
-            ddim_steps: 10,
-            iterations: 60,
-            lr: 0.02,
-            ..LatentConfig::default()
-        }),
-        Solver::Ik(ik.clone()),
-        Solver::Ik(IkConfig {
-            smoothness: IkConfig::ik_reg().smoothness,
-            ..ik
-        }),
-        Solver::Lbfgs(LbfgsConfig {
-            steps: 100,
-            ..LbfgsConfig::default()
-        }),
-    ]
+    ("ik", "ddim_steps", 10.0),
+    ("ik", "iterations", 100.0),
+    ("ik", "lr", 0.05),
+    ("ik-reg", "ddim_steps", 10.0),
+    ("ik-reg", "iterations", 100.0),
+    ("ik-reg", "lr", 0.05),
+    ("lbfgs", "steps", 100.0),
+];
+
+/// Every registered solver, with the benchmark's settings.
+pub fn solvers(settings: SolverSettings) -> Vec<Solver> {
+    crate::solve::registry()
+        .iter()
+        .map(|spec| {
+            let mut solver = (spec.make)();
+            if settings == SolverSettings::Fast {
+                for (_, knob, value) in FAST_KNOBS.iter().filter(|k| k.0 == spec.name) {
+                    solver
+                        .set_knob(knob, *value)
+                        .expect("FAST_KNOBS names knobs the solver has");
+                }
+            }
+            solver
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod fast_settings_tests {
+    use super::*;
+    use crate::solve::{GuideConfig, IkConfig};
+
+    #[test]
+    fn fast_settings_cover_registered_solvers_and_shorten_their_chains() {
+        let names = Solver::names();
+        for (solver, _, _) in FAST_KNOBS {
+            assert!(
+                names.contains(solver),
+                "FAST_KNOBS names unknown `{solver}`"
+            );
+        }
+        let fast = solvers(SolverSettings::Fast);
+        assert_eq!(fast.len(), names.len());
+        let guide = fast[0].config::<GuideConfig>().unwrap();
+        assert_eq!((guide.steps, guide.k_late, guide.late_steps), (100, 50, 5));
+        let ik_reg = fast.iter().find(|s| s.name() == "ik-reg").unwrap();
+        let c = ik_reg.config::<IkConfig>().unwrap();
+        assert_eq!((c.iterations, c.lr, c.smoothness), (100, 0.05, 0.1));
+        assert_eq!(
+            solvers(SolverSettings::Paper)[0],
+            Solver::by_name("guide").unwrap()
+        );
+    }
 }

@@ -20,7 +20,7 @@
 //!
 //! ```no_run
 //! # fn demo(walk: mprog::motion::Motion) -> Result<(), mprog::view::ViewError> {
-//! let meta = mprog::formats::Meta::new();
+//! let meta = mprog::motion::Meta::new();
 //! mprog::view::write_html(&[walk], &meta, "a person walks", "walk.html".as_ref())?;
 //! # Ok(()) }
 //! ```
@@ -42,7 +42,7 @@ pub use schema::{
     overlays_from_meta, overlays_to_meta, statement_errors_to_meta,
 };
 
-use crate::formats::Meta;
+use crate::motion::Meta;
 use crate::motion::Motion;
 use std::path::Path;
 

@@ -2,8 +2,8 @@
 //! (the timeline) and the constant geometry it names (walls, targets, regions).
 
 use super::schema::{contacts_to_meta, overlays_to_meta};
-use crate::formats::Meta;
 use crate::lang::{EvalError, Program};
+use crate::motion::Meta;
 use crate::motion::Motion;
 use burn::prelude::*;
 

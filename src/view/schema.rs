@@ -37,34 +37,12 @@
 //! schema, so a caller that ran a program can store what it drew.
 
 use super::ViewError;
-use crate::formats::Meta;
-use crate::render::Overlay;
+use crate::motion::Meta;
+pub use crate::scene::{Contact, JointOf, Overlay};
 use crate::skeleton::{JOINT_NAMES, NUM_JOINTS, joint_index};
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-
-/// One end of a contact: a joint of a person.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct JointOf {
-    /// Index into the people.
-    pub person: usize,
-    /// HumanML3D joint index.
-    pub joint: usize,
-}
-
-/// Two joints (usually of two people) that should touch over a range of frames.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Contact {
-    /// Shown beside the line when active.
-    pub label: Option<String>,
-    /// One end.
-    pub a: JointOf,
-    /// The other end.
-    pub b: JointOf,
-    /// First and last frame (inclusive) where the contact is active.
-    pub frames: (usize, usize),
-}
 
 /// The error of one program statement over the frames.
 #[derive(Clone, Debug, PartialEq)]

@@ -11,7 +11,7 @@
 //! certain; many impossible constraints (limb lengths between two joints) go unnoticed.
 
 use crate::lang::ir::{BinaryOp, Ir, NodeId, Op, UnaryOp};
-use crate::solve::Placement;
+use crate::scene::Placement;
 
 /// Ground distance a joint other than the pelvis reaches from the pelvis (m).
 const REACH: f64 = 1.4;

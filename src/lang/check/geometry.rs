@@ -15,8 +15,8 @@ use super::Checker;
 use super::values::{Cx, Env, Formula, Val};
 use crate::lang::ir::{NodeId, Op};
 use crate::lang::syntax::ast::{BinOp, Expr};
-use crate::render::Overlay;
-use crate::view::JointOf;
+use crate::scene::JointOf;
+use crate::scene::Overlay;
 use glam::Vec3;
 
 /// Half-length of the segment drawn for an infinite line (m).
@@ -227,7 +227,7 @@ fn overlay(name: &str, c: &[Vec<f32>]) -> Option<Overlay> {
 #[cfg(test)]
 mod tests {
     use crate::lang::compile;
-    use crate::render::Overlay;
+    use crate::scene::Overlay;
     use glam::Vec3;
 
     fn overlays(body: &str) -> Vec<Overlay> {
@@ -304,7 +304,7 @@ mod tests {
 #[cfg(test)]
 mod program_tests {
     use crate::lang::compile;
-    use crate::render::Overlay;
+    use crate::scene::Overlay;
 
     #[test]
     fn task_programs_draw_their_walls_and_regions() {

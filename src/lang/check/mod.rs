@@ -99,9 +99,9 @@ pub struct Checked {
     /// Its estimated cost.
     pub cost: CostEstimate,
     /// Constant geometry it names (walls, targets, regions), for pictures and the viewer.
-    pub overlays: Vec<crate::render::Overlay>,
+    pub overlays: Vec<crate::scene::Overlay>,
     /// Joint-pair contacts it asks for (`contact(a.r_hand, b.r_hand, d)`), with their frames.
-    pub contacts: Vec<crate::view::Contact>,
+    pub contacts: Vec<crate::scene::Contact>,
 }
 
 /// The checker's state while walking one program.
@@ -120,9 +120,9 @@ pub(crate) struct Checker<'a> {
     pub work: usize,
     pub statements: Vec<crate::lang::ir::Statement>,
     /// See [`Checked::overlays`].
-    pub overlays: Vec<crate::render::Overlay>,
+    pub overlays: Vec<crate::scene::Overlay>,
     /// Contacts as (end, end, frame domain), resolved into [`Checked::contacts`].
-    pub contacts: Vec<(crate::view::JointOf, crate::view::JointOf, usize)>,
+    pub contacts: Vec<(crate::scene::JointOf, crate::scene::JointOf, usize)>,
 }
 
 impl<'a> Checker<'a> {
@@ -316,7 +316,7 @@ pub fn module_to_ir<'a>(
         .iter()
         .filter_map(|&(a, b, domain)| {
             let frames = ir.resolve_domain(domain, ir.length);
-            Some(crate::view::Contact {
+            Some(crate::scene::Contact {
                 label: None,
                 a,
                 b,

@@ -136,12 +136,12 @@ pub fn labels_markdown(r: &EvalReport) -> String {
 /// One row per motion of what `mprog gen` made (speed, turn, hands, feet, acceleration),
 /// and a mean ± standard deviation row when there are several: enough to see at a glance
 /// whether a batch walks, turns or raises its hands as asked.
-pub fn motions_markdown(metrics: &[super::metrics::MotionMetrics]) -> String {
+pub fn motions_markdown(metrics: &[super::per_motion::MotionMetrics]) -> String {
     let mut out = String::from(
         "| motion | speed m/s | total turn (deg) | wrists above head (m) | foot skating | \
          max accel (m/frame²) |\n| --- | --- | --- | --- | --- | --- |\n",
     );
-    let columns = |m: &super::metrics::MotionMetrics| {
+    let columns = |m: &super::per_motion::MotionMetrics| {
         [
             m.speed,
             m.turn_deg,
@@ -178,7 +178,7 @@ pub fn motions_markdown(metrics: &[super::metrics::MotionMetrics]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eval::metrics::MotionMetrics;
+    use crate::metrics::per_motion::MotionMetrics;
 
     fn turning(turn_deg: f32) -> MotionMetrics {
         MotionMetrics {

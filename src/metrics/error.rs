@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 /// Anything that stops an evaluation or an evaluator training run.
 #[derive(Debug, thiserror::Error)]
-pub enum EvalError {
+pub enum MetricsError {
     /// The request cannot be served (too few clips, bad settings).
     #[error("{0}")]
     Invalid(String),
@@ -42,9 +42,9 @@ pub enum EvalError {
     },
 }
 
-/// A [`EvalError::File`] for `path`.
-pub fn file_error(path: &Path, reason: impl std::fmt::Display) -> EvalError {
-    EvalError::File {
+/// A [`MetricsError::File`] for `path`.
+pub fn file_error(path: &Path, reason: impl std::fmt::Display) -> MetricsError {
+    MetricsError::File {
         path: path.to_path_buf(),
         reason: reason.to_string(),
     }

@@ -10,7 +10,7 @@
 //! ```
 
 use super::encoder::{EncoderConfig, EvaluatorNet, motion_batch, rows_of};
-use super::error::{EvalError, file_error};
+use super::error::{MetricsError, file_error};
 use crate::dataset::store::{read_f32_npy, write_f32_npy};
 use crate::fsutil::write_bytes_atomic;
 use crate::model::text::{TokenBatch, Vocabulary};
@@ -76,7 +76,7 @@ pub fn default_evaluator_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/evaluator")
 }
 
-fn read_text(path: &Path) -> Result<String, EvalError> {
+fn read_text(path: &Path) -> Result<String, MetricsError> {
     std::fs::read_to_string(path).map_err(|e| file_error(path, e))
 }
 
@@ -96,7 +96,7 @@ pub fn net_from_safetensors(
 
 impl Evaluator {
     /// Loads an evaluator, checking its version and every shape.
-    pub fn load(dir: &Path, device: &Device) -> Result<Evaluator, EvalError> {
+    pub fn load(dir: &Path, device: &Device) -> Result<Evaluator, MetricsError> {
         let manifest_path = dir.join("manifest.json");
         let manifest: EvaluatorManifest = serde_json::from_str(&read_text(&manifest_path)?)
             .map_err(|e| file_error(&manifest_path, format!("bad evaluator manifest: {e}")))?;
@@ -126,7 +126,7 @@ impl Evaluator {
                 ),
             ));
         }
-        let stat = |name: &str| -> Result<Vec<f32>, EvalError> {
+        let stat = |name: &str| -> Result<Vec<f32>, MetricsError> {
             let p = dir.join(name);
             let (_, v) = read_f32_npy(&p, &[]).map_err(|e| file_error(&p, e))?;
             if v.len() != manifest.config.features || v.iter().any(|x| !x.is_finite()) {
@@ -161,7 +161,7 @@ impl Evaluator {
     }
 
     /// Writes the evaluator to `dir` (each file atomically), with its model card.
-    pub fn save(&self, dir: &Path) -> Result<(), EvalError> {
+    pub fn save(&self, dir: &Path) -> Result<(), MetricsError> {
         std::fs::create_dir_all(dir).map_err(|e| file_error(dir, e))?;
         let put = |name: &str, bytes: &[u8]| {
             let p = dir.join(name);
@@ -192,13 +192,13 @@ impl Evaluator {
         &self,
         motions: &[&[f32]],
         device: &Device,
-    ) -> Result<Vec<Vec<f32>>, EvalError> {
+    ) -> Result<Vec<Vec<f32>>, MetricsError> {
         let f = self.manifest.config.features;
         if let Some(bad) = motions
             .iter()
             .position(|m| m.is_empty() || !m.len().is_multiple_of(f))
         {
-            return Err(EvalError::Invalid(format!(
+            return Err(MetricsError::Invalid(format!(
                 "motion {bad} has {} values, not a positive multiple of {f} features",
                 motions[bad].len()
             )));
@@ -212,7 +212,7 @@ impl Evaluator {
                 self.manifest.config.max_frames,
                 device,
             );
-            out.extend(rows_of(self.net.motion.forward(x, valid)).map_err(EvalError::Invalid)?);
+            out.extend(rows_of(self.net.motion.forward(x, valid)).map_err(MetricsError::Invalid)?);
         }
         Ok(out)
     }
@@ -222,11 +222,11 @@ impl Evaluator {
         &self,
         captions: &[&str],
         device: &Device,
-    ) -> Result<Vec<Vec<f32>>, EvalError> {
+    ) -> Result<Vec<Vec<f32>>, MetricsError> {
         let mut out = Vec::with_capacity(captions.len());
         for chunk in captions.chunks(EMBED_BATCH) {
             let tokens = TokenBatch::new(&self.vocab, chunk, device);
-            out.extend(rows_of(self.net.text.forward(&tokens)).map_err(EvalError::Invalid)?);
+            out.extend(rows_of(self.net.text.forward(&tokens)).map_err(MetricsError::Invalid)?);
         }
         Ok(out)
     }

@@ -24,7 +24,7 @@ use crate::skeleton::{BONE_LENGTHS, NUM_JOINTS, PARENTS};
 use glam::Vec3;
 
 /// Feet used by the skating ratio (left foot, right foot).
-pub const SKATING_FEET: [usize; 2] = [10, 11];
+pub const SKATING_FEET: [usize; 2] = crate::skeleton::FEET;
 /// Height (m) below which a foot counts as touching the floor.
 pub const SKATING_HEIGHT: f32 = 0.05;
 /// Horizontal foot speed (m/s) above which a foot in contact skates.

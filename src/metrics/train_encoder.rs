@@ -8,7 +8,7 @@
 //! (InfoNCE with label-aware positives).
 
 use super::encoder::{EncoderConfig, EvaluatorNet, motion_batch};
-use super::error::EvalError;
+use super::error::MetricsError;
 use super::evaluator::{EVALUATOR_VERSION, Evaluator, EvaluatorManifest};
 use super::scores::{Distractor, r_precision};
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
@@ -146,7 +146,7 @@ pub fn split_r_precision(
     split: Split,
     seed: u64,
     device: &Device,
-) -> Result<Option<[f64; 3]>, EvalError> {
+) -> Result<Option<[f64; 3]>, MetricsError> {
     let clips: Vec<&ClipInfo> = data
         .clips(split)
         .filter(|c| c.frames >= 2 && !c.captions.is_empty())
@@ -189,16 +189,16 @@ pub fn train_evaluator(
     data: &Dataset,
     cfg: &EncoderTrainConfig,
     progress: &mut dyn FnMut(usize, f32),
-) -> Result<(Evaluator, Vec<f32>), EvalError> {
-    cfg.encoder.validate().map_err(EvalError::Invalid)?;
+) -> Result<(Evaluator, Vec<f32>), MetricsError> {
+    cfg.encoder.validate().map_err(MetricsError::Invalid)?;
     if cfg.encoder.features != FEATURE_DIM || data.mean.len() != FEATURE_DIM {
-        return Err(EvalError::Invalid(format!(
+        return Err(MetricsError::Invalid(format!(
             "the evaluator reads {FEATURE_DIM} features, configured for {}",
             cfg.encoder.features
         )));
     }
     if cfg.batch_size < 2 || cfg.steps == 0 || cfg.crop_frames < 2 {
-        return Err(EvalError::Invalid(
+        return Err(MetricsError::Invalid(
             "evaluator training needs batch_size ≥ 2, steps ≥ 1 and crop_frames ≥ 2".into(),
         ));
     }
@@ -207,7 +207,7 @@ pub fn train_evaluator(
         .filter(|c| c.frames >= 2 && !c.captions.is_empty())
         .collect();
     if clips.len() < 2 {
-        return Err(EvalError::Invalid(
+        return Err(MetricsError::Invalid(
             "the dataset has fewer than two captioned training clips".into(),
         ));
     }
@@ -232,7 +232,7 @@ pub fn train_evaluator(
         let loss = batch_loss(&net, data, &vocab, &batch, cfg, &device);
         let value = loss.clone().into_scalar::<f32>();
         if !value.is_finite() {
-            return Err(EvalError::Diverged { step, loss: value });
+            return Err(MetricsError::Diverged { step, loss: value });
         }
         let grads = GradientsParams::from_grads(loss.backward(), &net);
         net = optim.step(learning_rate(cfg, step), net, grads);

@@ -11,9 +11,9 @@
 //! * Per label (optional): the baseline table's descriptors for real test clips of a label
 //!   and for `per_label` motions generated from captions of that label.
 
-use super::error::EvalError;
+use super::error::MetricsError;
 use super::evaluator::Evaluator;
-use super::metrics::MotionMetrics;
+use super::per_motion::MotionMetrics;
 use super::scores::{DIVERSITY_PAIRS, Distractor, diversity, fid, r_precision};
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM, Split};
 use crate::features::{ExtractOptions, extract};
@@ -192,7 +192,7 @@ fn frozen_motion(
     data: &Dataset,
     clip: &ClipInfo,
     frames: usize,
-) -> Result<(Motion, Vec<f32>), EvalError> {
+) -> Result<(Motion, Vec<f32>), MetricsError> {
     let first = Motion::from_flat(&data.clip_joints(clip)[..66]).frames[0];
     let motion = Motion::new(vec![first; frames]);
     // F + 1 frames give F feature rows.
@@ -209,7 +209,7 @@ fn generate_for(
     seed: u64,
     device: &Device,
     log: &mut dyn FnMut(&str),
-) -> Result<MotionSet, EvalError> {
+) -> Result<MotionSet, MetricsError> {
     let mut order: Vec<usize> = (0..prompts.len()).collect();
     order.sort_by_key(|&i| prompts[i].frames);
     let mut out: Vec<Option<(Motion, Vec<f32>)>> = vec![None; prompts.len()];
@@ -245,7 +245,7 @@ fn generate_for(
     let mut set = MotionSet::default();
     for (p, o) in prompts.iter().zip(out) {
         let (motion, features) =
-            o.ok_or_else(|| EvalError::Invalid("a prompt was not generated".into()))?;
+            o.ok_or_else(|| MetricsError::Invalid("a prompt was not generated".into()))?;
         set.motions.push(motion);
         set.features.push(features);
         set.captions.push(p.caption.clone());
@@ -285,7 +285,7 @@ fn score_set(
     evaluator: &Evaluator,
     seed: u64,
     device: &Device,
-) -> Result<SetScores, EvalError> {
+) -> Result<SetScores, MetricsError> {
     let rows: Vec<&[f32]> = set.features.iter().map(Vec::as_slice).collect();
     let motions = evaluator.embed_motions(&rows, device)?;
     let captions: Vec<&str> = set.captions.iter().map(String::as_str).collect();
@@ -327,9 +327,9 @@ pub fn run_eval(
     settings: &EvalSettings,
     device: &Device,
     log: &mut dyn FnMut(&str),
-) -> Result<(EvalReport, Vec<Sample>), EvalError> {
+) -> Result<(EvalReport, Vec<Sample>), MetricsError> {
     if bundle.config.features != FEATURE_DIM || evaluator.manifest.config.features != FEATURE_DIM {
-        return Err(EvalError::Invalid(format!(
+        return Err(MetricsError::Invalid(format!(
             "model and evaluator must both read {FEATURE_DIM} features"
         )));
     }
@@ -343,7 +343,7 @@ pub fn run_eval(
         .collect();
     let count = settings.count.min(eligible.len());
     if count < 2 {
-        return Err(EvalError::Invalid(format!(
+        return Err(MetricsError::Invalid(format!(
             "the test split has {} clips of at least {} frames; at least 2 are needed",
             eligible.len(),
             settings.min_frames
@@ -367,7 +367,7 @@ pub fn run_eval(
         .filter(|c| !sources.contains(c.source.as_str()))
         .collect();
     if reference_clips.len() < 2 {
-        return Err(EvalError::Invalid(format!(
+        return Err(MetricsError::Invalid(format!(
             "only {} test clips are left for the FID reference; lower --count",
             reference_clips.len()
         )));

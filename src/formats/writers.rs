@@ -1,0 +1,75 @@
+//! The writers of the output table ([`super::outputs::OUTPUT_KINDS`]): each turns an
+//! [`OutputJob`] into the bytes of one file, or says why it cannot.
+
+use super::outputs::OutputJob;
+use crate::motion::Motion;
+
+/// `.bvh`: one person (the table splits people into files).
+pub fn bvh(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
+    let [person] = job.people else {
+        return Err(format!(
+            "{origin}: a BVH file holds one skeleton but there are {} people; write one .bvh per person or use .json/.npy",
+            job.people.len()
+        ));
+    };
+    // bvh_string refuses non-finite positions itself (naming frame and joint).
+    super::bvh_export::bvh_string(person, job.bvh)
+        .map(String::into_bytes)
+        .map_err(|e| format!("{origin}: {e}"))
+}
+
+/// `.npy`: float32 joint positions.
+pub fn npy(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
+    check_finite(origin, job.people)?;
+    super::npy::joints_npy_bytes(origin, job.people).map_err(|e| e.to_string())
+}
+
+/// `.json`: an mprog-motion document with the job's meta.
+pub fn json(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
+    check_finite(origin, job.people)?;
+    let people = super::file::default_names(job.people.to_vec());
+    super::json::json_bytes(origin, &people, job.meta).map_err(|e| e.to_string())
+}
+
+/// `.gif`: the animation, with the overlays in the meta.
+pub fn gif(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
+    crate::render::gif_bytes(job.people, &picture_options(origin, job)?)
+        .map_err(|e| format!("cannot render {origin}: {e}"))
+}
+
+/// `.png`: a strip of frames, with the overlays in the meta.
+pub fn png(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
+    crate::render::strip_bytes(job.people, &picture_options(origin, job)?)
+        .map_err(|e| format!("cannot render {origin}: {e}"))
+}
+
+/// `.html`: the viewer page, with the program's geometry and timelines in the meta.
+pub fn html(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
+    crate::view::html_string(job.people, job.meta, job.title)
+        .map(String::into_bytes)
+        .map_err(|e| format!("{origin}: {e}"))
+}
+
+fn picture_options(origin: &str, job: &OutputJob) -> Result<crate::render::RenderOptions, String> {
+    let mut opts = crate::render::RenderOptions::titled(job.title);
+    opts.overlays =
+        crate::view::overlays_from_meta(job.meta).map_err(|e| format!("{origin}: {e}"))?;
+    Ok(opts)
+}
+
+/// Refuses non-finite joints: JSON would turn them into `null`, `.npy` would carry them.
+pub fn check_finite(origin: &str, people: &[Motion]) -> Result<(), String> {
+    for (p, m) in people.iter().enumerate() {
+        if let Some(f) = m
+            .frames
+            .iter()
+            .position(|pose| !pose.iter().all(|v| v.is_finite()))
+        {
+            return Err(format!(
+                "{origin}: person {} frame {f} has non-finite joint positions",
+                p + 1
+            ));
+        }
+    }
+    Ok(())
+}
