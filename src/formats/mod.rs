@@ -3,6 +3,7 @@
 //! documents with reproduction metadata ([`json`]), and one entry point for all of them
 //! ([`read_motion`], [`write_motion`]).
 
+pub mod asf;
 pub mod bvh;
 pub mod bvh_export;
 mod file;
