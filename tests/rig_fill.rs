@@ -1,7 +1,8 @@
 //! The DeepMimic fill policy measured: a real 22-joint clip (HumanML3D's golden clip
 //! 012314, shipped under `tests/fixtures/`, MIT) reduced to the joints a DeepMimic file has
-//! (pelvis, chest = spine2, neck, hips, knees, ankles, shoulders, elbows; wrists and toes
-//! as End Sites), then filled back by the `deepmimic` rig table. Prints the error of every
+//! (root on the line between the hips, chest = spine2, neck, hips, knees, ankles,
+//! shoulders, elbows; wrists and toes as End Sites), then filled back by the `deepmimic`
+//! rig table. Prints the error of every
 //! filled joint next to the generic fill the importer falls back on (spine at HumanML3D's
 //! rest proportions pelvis → neck, collars halfway spine3 → shoulder), and what the fill
 //! does to every joint once both clips are retargeted to HumanML3D's skeleton (what
@@ -89,15 +90,18 @@ fn golden() -> Vec<Pose> {
     }
 }
 
-/// Generic fill: spine at rest proportions between pelvis and neck, collars halfway
+/// Generic fill: the root as the pelvis, spine at rest proportions between it and the neck, collars halfway
 /// spine3 → shoulder.
 fn generic(p: &Pose, j: usize) -> Vec3 {
-    let spine = |t: f32| p[0].lerp(p[12], t);
+    // The importer's fallback takes the root as the pelvis.
+    let root = p[1].lerp(p[2], 0.5);
+    let spine = |t: f32| root.lerp(p[12], t);
     // Cumulative rest lengths pelvis–spine1–spine2–spine3–neck (skeleton::BONE_LENGTHS).
     let s1 = 0.13157;
     let s3 = s1 + 0.14319 + 0.05736;
     let neck = s3 + 0.21936;
     match j {
+        0 => root,
         3 => spine(s1 / neck),
         9 => spine(s3 / neck),
         13 => spine(s3 / neck).lerp(p[16], 0.5),
@@ -111,12 +115,14 @@ fn deepmimic_fill_against_a_real_22_joint_clip() {
     let map = map_joints(&bvh).unwrap();
     assert_eq!(map.rig, "deepmimic");
     let frames = golden();
-    let filled = [3usize, 9, 13, 14];
-    let mut table_err = [0.0f32; 4];
+    let filled = [0usize, 3, 9, 13, 14];
+    let mut table_err = [0.0f32; 5];
     let mut filled_clip = Vec::new();
-    let mut generic_err = [0.0f32; 4];
+    let mut generic_err = [0.0f32; 5];
     for truth in &frames {
         let mut globals: Vec<Vec3> = REDUCED.iter().map(|(_, _, h)| truth[*h]).collect();
+        // DeepMimic's root lies on the line between the hips.
+        globals[0] = truth[1].lerp(truth[2], 0.5);
         globals.push(truth[10]);
         // The neck's End Site sits so that the table's head (0.36 of the way) is the head.
         globals.push(truth[12] + (truth[15] - truth[12]) / 0.36);
@@ -140,8 +146,8 @@ fn deepmimic_fill_against_a_real_22_joint_clip() {
             generic_err[k] / n
         );
     }
-    let table: f32 = table_err.iter().sum::<f32>() / (4.0 * n);
-    let generic: f32 = generic_err.iter().sum::<f32>() / (4.0 * n);
+    let table: f32 = table_err.iter().sum::<f32>() / (5.0 * n);
+    let generic: f32 = generic_err.iter().sum::<f32>() / (5.0 * n);
     println!("all filled   {table:>15.3} {generic:>13.3}");
     // What training sees: both clips on HumanML3D's skeleton, compared joint by joint.
     let retarget = |frames: Vec<Pose>| {

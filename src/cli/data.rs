@@ -28,6 +28,10 @@ pub struct BuildArgs {
     /// Do not add left/right mirrored copies.
     #[arg(long)]
     no_mirror: bool,
+    /// Shortest clip kept, in frames at 20 fps (HDM05's single hops and kicks last
+    /// 10–20 frames: `--min-frames 10` keeps them).
+    #[arg(long, default_value_t = 20)]
+    min_frames: usize,
 }
 
 /// Runs `mprog data …`.
@@ -47,7 +51,7 @@ fn build(args: BuildArgs) -> Result<()> {
     );
     let opts = BuildOptions {
         mirror: !args.no_mirror,
-        ..BuildOptions::default()
+        min_frames: args.min_frames,
     };
     let built =
         build_dataset_report(&args.bvh, &args.out, &opts, &|_| bar.inc(1)).into_diagnostic()?;

@@ -164,6 +164,9 @@ pub fn map_joints(bvh: &Bvh) -> Result<JointMap, BvhErrorKind> {
 fn resolve(bvh: &Bvh, pick: Pick) -> Option<JointSource> {
     Some(match pick {
         Pick::Joint(a) => JointSource::Joint(rigs::find_joint(bvh, a)?),
+        Pick::OneOf(names) => {
+            JointSource::Joint(names.iter().find_map(|a| rigs::find_joint(bvh, a))?)
+        }
         Pick::Between(a, b, t) => JointSource::Between {
             a: rigs::find_joint(bvh, a)?,
             b: rigs::find_joint(bvh, b)?,

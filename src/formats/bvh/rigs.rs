@@ -23,6 +23,8 @@ use crate::skeleton::NUM_JOINTS;
 pub enum Pick {
     /// A source joint.
     Joint(&'static str),
+    /// The first of these source joints the file has (one rig, several exporters).
+    OneOf(&'static [&'static str]),
     /// `t` of the way from source joint `a` to source joint `b`.
     Between(&'static str, &'static str, f32),
     /// `t` of the way from a source joint to its (first) End Site.
@@ -41,7 +43,7 @@ pub struct RigTable {
     pub end_sites: &'static [(&'static str, [f32; 3])],
 }
 
-use Pick::{Between, End, Joint};
+use Pick::{Between, End, Joint, OneOf};
 
 /// Bandai-Namco (verified on walk files: `_L` joints lie on the person's left). spine2 has
 /// no joint: placed between Spine and Chest at HumanML3D's rest proportions.
@@ -108,11 +110,13 @@ pub const CGSPEED_MB: RigTable = RigTable {
 
 /// The CMU ASF names (CMU's own `.asf`, HDM05). A joint named after a bone sits where the
 /// bone starts: `lfemur` is the hip, `ltibia` the knee, `lfoot` the ankle, `lhumerus` the
-/// shoulder. Spine: upperback 0.12 m, thorax 0.25, lowerneck 0.37, upperneck 0.47.
+/// shoulder. Spine: upperback 0.12 m, thorax 0.25, lowerneck 0.37, upperneck 0.47; spine3
+/// is taken between thorax and upperneck, because cgspeed's ASF-named files (CMU 16_01,
+/// 16_02, whose root is `hip`) put lowerneck on the thorax as their MotionBuilder rig does.
 pub const CMU_ASF: RigTable = RigTable {
     name: "cmu-asf",
     picks: [
-        Joint("root"),
+        OneOf(&["root", "hip"]),
         Joint("lfemur"),
         Joint("rfemur"),
         Joint("upperback"),
@@ -121,7 +125,7 @@ pub const CMU_ASF: RigTable = RigTable {
         Joint("thorax"),
         Joint("lfoot"),
         Joint("rfoot"),
-        Between("thorax", "lowerneck", 0.25),
+        Between("thorax", "upperneck", 0.2),
         Joint("ltoes"),
         Joint("rtoes"),
         Joint("upperneck"),
@@ -139,8 +143,9 @@ pub const CMU_ASF: RigTable = RigTable {
 };
 
 /// DeepMimic's humanoid3d (13 joints in the CMU conversions, 15 in DeepMimic's own files,
-/// whose wrists are End Sites either way). It has no spine joints, collars or toes:
-/// spine1 halfway root→chest, spine2 = chest (0.24 m up), spine3 20 % of the way
+/// whose wrists are End Sites either way). Its root sits on the line between the hips
+/// (HumanML3D's pelvis is 6–10 cm above it), and it has no spine joints, collars or toes:
+/// pelvis 25 % and spine1 60 % of the way root→chest, spine2 = chest, spine3 20 % of the way
 /// chest→neck, collars halfway neck→shoulder (the fractions of least error on the golden
 /// clip, `tests/rig_fill.rs`), toes and head from the End Sites of
 /// the ankles and the neck (the humanoid's foot box and head sphere; the 15-joint files
@@ -148,10 +153,10 @@ pub const CMU_ASF: RigTable = RigTable {
 pub const DEEPMIMIC: RigTable = RigTable {
     name: "deepmimic",
     picks: [
-        Joint("root"),
+        Between("root", "chest", 0.25),
         Joint("left_hip"),
         Joint("right_hip"),
-        Between("root", "chest", 0.5),
+        Between("root", "chest", 0.6),
         Joint("left_knee"),
         Joint("right_knee"),
         Joint("chest"),
@@ -202,6 +207,7 @@ impl RigTable {
     pub fn fits(&self, bvh: &Bvh) -> bool {
         self.picks.iter().all(|p| match *p {
             Joint(a) => find_joint(bvh, a).is_some(),
+            OneOf(names) => names.iter().any(|a| find_joint(bvh, a).is_some()),
             Between(a, b, _) => find_joint(bvh, a).is_some() && find_joint(bvh, b).is_some(),
             End(a, _) => find_joint(bvh, a).is_some_and(|j| end_site_of(bvh, j).is_some()),
         })
@@ -247,6 +253,7 @@ mod tests {
             for (j, pick) in table.picks.iter().enumerate() {
                 let name = match pick {
                     Joint(a) | End(a, _) => *a,
+                    OneOf(names) => names[0],
                     Between(_, b, _) => *b,
                 };
                 let lower = name.to_ascii_lowercase();
