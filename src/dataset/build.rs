@@ -47,7 +47,7 @@ impl Default for BuildOptions {
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
     /// Nothing to build from.
-    #[error("no .bvh or .amc files under {0}")]
+    #[error("no .bvh files (nor .amc) under {0}")]
     NoFiles(PathBuf),
     /// Every file failed.
     #[error("none of the {0} BVH files could be converted; first error: {1}")]
