@@ -8,7 +8,7 @@ cd "$(dirname "$0")"
 seconds="${1:-300}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(mprog_check bvh npy json)
+[ ${#targets[@]} -eq 0 ] && targets=(mprog_check bvh npy json asf)
 root=..
 
 seed() { # target, files…
@@ -22,6 +22,9 @@ seed() { # target, files…
 seed mprog_check "$root"/programs/*.mprog "$root"/stdlib/*.mprog "$root"/tests/diagnostics/*.mprog
 seed bvh "$root"/tests/fixtures/bandai_like.bvh "$root"/tests/fixtures/adversarial/[a-z]*.bvh \
     "$root"/tests/fixtures/fuzz/bvh/*
+# AMC seeds for the test skeleton: the first two frames of the fixture.
+mkdir -p corpus/asf
+head -n 52 "$root"/tests/fixtures/rigs/asf/HDM_tt_squat1Reps_001_120.amc >corpus/asf/seed-two-frames.amc
 seed npy "$root"/tests/fixtures/humanml3d/Mean.npy "$root"/tests/fixtures/adversarial/*.npy \
     "$root"/tests/fixtures/fuzz/npy/*
 seed json "$root"/tests/fixtures/adversarial/*.json "$root"/tests/fixtures/fuzz/json/*
@@ -31,7 +34,7 @@ export RUSTC_BOOTSTRAP=1
 for t in "${targets[@]}"; do
     mkdir -p "artifacts/$t"
     # Deep inputs need room: 8 kB for BVH/JSON (a whole small rig), 4 kB otherwise.
-    case "$t" in bvh | json) len=8192 ;; *) len=4096 ;; esac
+    case "$t" in bvh | json | asf) len=8192 ;; *) len=4096 ;; esac
     cargo fuzz run -O -a -s none "$t" "corpus/$t" -- \
         -workers=1 -max_total_time="$seconds" -max_len="$len" \
         -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \

@@ -1,14 +1,14 @@
-//! `mprog data build`: convert a folder of BVH files into a training set.
+//! `mprog data build`: convert a folder of BVH (and ASF/AMC) files into a training set.
 
 use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result};
-use mprog::dataset::build::{BuildOptions, build_dataset, find_bvh_files};
+use mprog::dataset::build::{BuildOptions, build_dataset_report, find_motion_files};
 use std::path::PathBuf;
 
 /// `mprog data …`
 #[derive(clap::Subcommand)]
 pub enum DataCommand {
-    /// Convert every BVH file under a folder into one training set.
+    /// Convert every BVH and ASF/AMC file under a folder into one training set.
     Build(BuildArgs),
     /// Write one clip of a training set as a motion file or picture.
     Show(ShowArgs),
@@ -17,7 +17,9 @@ pub enum DataCommand {
 /// Arguments of `mprog data build`.
 #[derive(clap::Args)]
 pub struct BuildArgs {
-    /// Folder searched recursively for `.bvh` files (e.g. the unpacked Bandai Namco archive).
+    /// Folder searched recursively for `.bvh` and `.amc` files (the unpacked Bandai Namco,
+    /// CMU and HDM05 archives, together or alone; CMU captions need the
+    /// `cmu_trial_index.csv` somewhere under it).
     #[arg(long)]
     bvh: PathBuf,
     /// Output folder (replaced atomically when the build succeeds).
@@ -26,6 +28,10 @@ pub struct BuildArgs {
     /// Do not add left/right mirrored copies.
     #[arg(long)]
     no_mirror: bool,
+    /// Shortest clip kept, in frames at 20 fps (HDM05's single hops and kicks last
+    /// 10–20 frames: `--min-frames 10` keeps them).
+    #[arg(long, default_value_t = 20)]
+    min_frames: usize,
 }
 
 /// Runs `mprog data …`.
@@ -37,7 +43,7 @@ pub fn run(cmd: DataCommand) -> Result<()> {
 }
 
 fn build(args: BuildArgs) -> Result<()> {
-    let count = find_bvh_files(&args.bvh).len();
+    let count = find_motion_files(&args.bvh).len();
     let bar = ProgressBar::new(count as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} files  [{elapsed_precise}, eta {eta}]")
@@ -45,9 +51,11 @@ fn build(args: BuildArgs) -> Result<()> {
     );
     let opts = BuildOptions {
         mirror: !args.no_mirror,
-        ..BuildOptions::default()
+        min_frames: args.min_frames,
     };
-    let index = build_dataset(&args.bvh, &args.out, &opts, &|_| bar.inc(1)).into_diagnostic()?;
+    let built =
+        build_dataset_report(&args.bvh, &args.out, &opts, &|_| bar.inc(1)).into_diagnostic()?;
+    let index = built.index;
     bar.finish_and_clear();
     for (path, reason) in &index.skipped {
         eprintln!("skipped {path}: {reason}");
@@ -69,6 +77,19 @@ fn build(args: BuildArgs) -> Result<()> {
         index.skipped.len(),
         opts.mirror
     );
+    println!(
+        "\n{:10} {:16} {:>6} {:>8} {:>8}",
+        "source", "rig", "read", "skipped", "minutes"
+    );
+    for r in &built.rigs {
+        println!(
+            "{:10} {:16} {:>6} {:>8} {:>8.1}",
+            r.family, r.rig, r.read, r.skipped, r.minutes
+        );
+        for (reason, n) in &r.reasons {
+            println!("    {n} × {reason}");
+        }
+    }
     Ok(())
 }
 

@@ -4,6 +4,9 @@
 
 pub mod build;
 pub mod captions;
+pub mod captions_cmu;
+pub mod captions_hdm05;
+pub mod labels;
 pub mod split;
 pub mod stats;
 pub mod store;

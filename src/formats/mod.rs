@@ -6,6 +6,7 @@
 //! Every output, motion data, pictures and pages alike, is one row of the table of output
 //! kinds ([`outputs::OUTPUT_KINDS`]); [`write_outputs`] is the export stage's entry point.
 
+pub mod asf;
 pub mod bvh;
 pub mod bvh_export;
 mod file;

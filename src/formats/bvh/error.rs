@@ -110,6 +110,8 @@ pub enum BvhErrorKind {
     NonFinitePosition { frame: usize, joint: &'static str },
     #[error("invalid import option: {0}")]
     BadOption(String),
+    #[error("ASF/AMC: {0}")]
+    Asf(String),
 }
 
 impl BvhError {

@@ -6,8 +6,9 @@
 //! | text | [`text`] | bytes → checked UTF-8, tokens with lines |
 //! | parse | [`parse`], [`hierarchy`], [`frames`] | text → [`Bvh`] |
 //! | kinematics | [`fk`] | [`Bvh`] → global joint positions (file units) |
-//! | retarget | [`names`], [`retarget`] | joint names → [`JointMap`] → 22 joints |
-//! | units | [`units`] | file units / up axis → metres, Y up |
+//! | retarget | [`rigs`], [`names`], [`retarget`] | joint names → [`JointMap`] → 22 joints |
+//! | rest frame | [`tpose`] | a leading T-pose frame is dropped |
+//! | units | [`units`] | leg length / up axis → metres, Y up |
 //!
 //! Entry points: [`import_bvh`] (a file) and [`import_bvh_str`] (text, for tests and
 //! fuzzing). Errors name the input and line ([`BvhError`]).
@@ -19,7 +20,9 @@ pub mod hierarchy;
 pub mod names;
 pub mod parse;
 pub mod retarget;
+pub mod rigs;
 pub mod text;
+pub mod tpose;
 pub mod units;
 
 #[cfg(test)]
@@ -112,6 +115,16 @@ pub fn import_bvh_str(
     text: &str,
     opts: &BvhImportOptions,
 ) -> Result<BvhImport, BvhError> {
+    let bvh = parse_bvh(origin, text, opts.limits)?;
+    import_parsed(origin, bvh, opts)
+}
+
+/// Imports a parsed (or built, see [`crate::formats::asf`]) skeleton and motion.
+pub fn import_parsed(
+    origin: &str,
+    mut bvh: Bvh,
+    opts: &BvhImportOptions,
+) -> Result<BvhImport, BvhError> {
     if !(opts.fps.is_finite() && opts.fps > 0.0) {
         return Err(BvhError::whole(
             origin,
@@ -126,12 +139,14 @@ pub fn import_bvh_str(
             BvhErrorKind::BadOption(format!("unit scale must be positive, got {s}")),
         ));
     }
-    let bvh = parse_bvh(origin, text, opts.limits)?;
+    let end_site_notes = rigs::complete_end_sites(&mut bvh);
     let joint_map = retarget::map_joints(&bvh).map_err(|kind| BvhError::whole(origin, kind))?;
+    // cgspeed's CMU files (and other MotionBuilder exports) start with a T-pose frame.
+    let skip = tpose::leading_tpose_frames(&bvh, &joint_map, opts.up);
     let source_fps = bvh.fps();
     // A long frame time makes many output frames from few lines: bound what FK allocates.
-    let out_values =
-        fk::sample_count(bvh.frame_count, source_fps, opts.fps) * (bvh.joints.len() * 3) as f64;
+    let kept = bvh.frame_count - skip;
+    let out_values = fk::sample_count(kept, source_fps, opts.fps) * (bvh.joints.len() * 3) as f64;
     if out_values > opts.limits.max_values as f64 {
         let kind = BvhErrorKind::TooBig {
             what: "frames after resampling × joints × 3",
@@ -141,7 +156,14 @@ pub fn import_bvh_str(
         return Err(BvhError::whole(origin, kind));
     }
     // Resampled on the channels, so bones stay rigid (see `fk`).
-    let samples = fk::sample_points(bvh.frame_count, source_fps, opts.fps);
+    let samples: Vec<fk::SamplePoint> = fk::sample_points(kept, source_fps, opts.fps)
+        .into_iter()
+        .map(|p| fk::SamplePoint {
+            i0: p.i0 + skip,
+            i1: p.i1 + skip,
+            t: p.t,
+        })
+        .collect();
     let globals = fk::global_positions_at(&bvh, &samples);
     let joint_count = bvh.joints.len();
     let file_poses: Vec<Pose> = globals
@@ -149,13 +171,27 @@ pub fn import_bvh_str(
         .map(|g| joint_map.pose(g))
         .collect();
 
-    let mut warnings = joint_map.warnings.clone();
+    let mut warnings = end_site_notes;
+    warnings.extend(joint_map.warnings.iter().cloned());
+    if skip > 0 {
+        warnings.push(format!(
+            "dropped {skip} leading T-pose frame(s) of {}",
+            bvh.frame_count
+        ));
+    }
     let (unit_scale, units_detected) = match opts.units.scale() {
         Some(s) => (s, false),
         None => {
             let step = (file_poses.len() / 16).max(1);
             let sample: Vec<Pose> = file_poses.iter().step_by(step).copied().collect();
-            (units::detect_scale(&sample), true)
+            let (scale, from) = units::detect_scale(&sample);
+            if from == units::ScaleFrom::LegLength {
+                warnings.push(format!(
+                    "no standard unit gives a human leg: scaled to a {} m leg ({scale:.5} m per file unit)",
+                    units::TYPICAL_LEG
+                ));
+            }
+            (scale, true)
         }
     };
     let body = units::body_path_length(&file_poses[0]) * unit_scale;

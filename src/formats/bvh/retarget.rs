@@ -4,8 +4,9 @@
 //! joint or a point between two already-placed HumanML3D joints. Two ways to build it:
 //! * exact tables, used when all of their names are present: the 22 HumanML3D names
 //!   (mprog's own BVH export, whose zero-offset connector joints must not be taken for
-//!   spine joints) and the Bandai-Namco names;
-//! * name matching for other rigs (CMU, Mixamo, SMPL, UE, Biped, Blender `.L/.R`), with the
+//!   spine joints) and one table per rig family in [`super::rigs`] (Bandai-Namco, CMU
+//!   cgspeed, CMU/HDM05 ASF names, DeepMimic);
+//! * name matching for other rigs (Daz, Mixamo, SMPL, UE, Biped, Blender `.L/.R`), with the
 //!   spine taken from the hierarchy between pelvis and neck.
 //!
 //! Joints with no counterpart are filled where that is safe: spine joints by interpolation
@@ -16,6 +17,7 @@
 use super::error::BvhErrorKind;
 use super::names::{NameParts, Side, split_name};
 use super::parse::Bvh;
+use super::rigs::{self, Pick};
 use crate::motion::Pose;
 use crate::skeleton::{BONE_LENGTHS, JOINT_NAMES, NUM_JOINTS};
 use glam::Vec3;
@@ -28,12 +30,15 @@ pub enum JointSource {
     /// `(1 − t)·target[from] + t·target[to]`, between two HumanML3D joints placed earlier
     /// (lower index or a direct joint).
     Lerp { from: usize, to: usize, t: f32 },
+    /// `(1 − t)·source[a] + t·source[b]`, between two BVH joints (End Sites allowed).
+    Between { a: usize, b: usize, t: f32 },
 }
 
 /// The joint map used for an import.
 #[derive(Clone, Debug, PartialEq)]
 pub struct JointMap {
-    /// `bandai-namco` or `name-matched`.
+    /// `humanml3d`, a [`rigs::RigTable`] name (`bandai-namco`, `cmu-asf`, …) or
+    /// `name-matched`.
     pub rig: &'static str,
     /// Source of each HumanML3D joint, index = HumanML3D joint.
     pub sources: [JointSource; NUM_JOINTS],
@@ -48,8 +53,10 @@ impl JointMap {
     pub fn pose(&self, globals: &[Vec3]) -> Pose {
         let mut pose = [Vec3::ZERO; NUM_JOINTS];
         for (j, source) in self.sources.iter().enumerate() {
-            if let JointSource::Joint(index) = *source {
-                pose[j] = globals[index];
+            match *source {
+                JointSource::Joint(index) => pose[j] = globals[index],
+                JointSource::Between { a, b, t } => pose[j] = globals[a].lerp(globals[b], t),
+                JointSource::Lerp { .. } => {}
             }
         }
         for (j, source) in self.sources.iter().enumerate() {
@@ -71,56 +78,42 @@ impl JointMap {
                     "{} ← {t:.2} of the way {} → {}",
                     JOINT_NAMES[j], JOINT_NAMES[from], JOINT_NAMES[to]
                 ),
+                JointSource::Between { a, b, t } => format!(
+                    "{} ← {t:.2} of the way {} → {}",
+                    JOINT_NAMES[j],
+                    bvh.joints[a].name,
+                    joint_label(bvh, b)
+                ),
             })
             .collect()
     }
 }
 
-/// The Bandai-Namco Research Motiondataset skeleton (verified on walk files: `_L` joints
-/// lie on the person's left). spine2 has no joint and is interpolated.
-pub const BANDAI_NAMES: [(usize, &str); 21] = [
-    (0, "Hips"),
-    (1, "UpperLeg_L"),
-    (2, "UpperLeg_R"),
-    (3, "Spine"),
-    (4, "LowerLeg_L"),
-    (5, "LowerLeg_R"),
-    (7, "Foot_L"),
-    (8, "Foot_R"),
-    (9, "Chest"),
-    (10, "Toes_L"),
-    (11, "Toes_R"),
-    (12, "Neck"),
-    (13, "Shoulder_L"),
-    (14, "Shoulder_R"),
-    (15, "Head"),
-    (16, "UpperArm_L"),
-    (17, "UpperArm_R"),
-    (18, "LowerArm_L"),
-    (19, "LowerArm_R"),
-    (20, "Hand_L"),
-    (21, "Hand_R"),
-];
+/// `name` or `name's End Site`.
+fn joint_label(bvh: &Bvh, j: usize) -> String {
+    let joint = &bvh.joints[j];
+    match (joint.end_site, joint.parent) {
+        (true, Some(p)) => format!("End Site of {}", bvh.joints[p].name),
+        _ => joint.name.clone(),
+    }
+}
 
-/// Builds the joint map: the Bandai table when it fits, name matching otherwise.
+/// Builds the joint map: HumanML3D's own names, else the first rig table that fits
+/// ([`rigs::detect`]), else name matching.
 pub fn map_joints(bvh: &Bvh) -> Result<JointMap, BvhErrorKind> {
     let mut found: [Option<JointSource>; NUM_JOINTS] = [None; NUM_JOINTS];
     let mut warnings = Vec::new();
-    let bandai: Option<Vec<usize>> = BANDAI_NAMES
-        .iter()
-        .map(|(_, n)| bvh.joint_index(n))
-        .collect();
     let humanml3d: Option<Vec<usize>> = JOINT_NAMES.iter().map(|n| bvh.joint_index(n)).collect();
     let rig = if let Some(indices) = humanml3d {
         for (target, index) in indices.into_iter().enumerate() {
             found[target] = Some(JointSource::Joint(index));
         }
         "humanml3d"
-    } else if let Some(indices) = bandai {
-        for ((target, _), index) in BANDAI_NAMES.iter().zip(indices) {
-            found[*target] = Some(JointSource::Joint(index));
+    } else if let Some(table) = rigs::detect(bvh) {
+        for (target, pick) in table.picks.iter().enumerate() {
+            found[target] = resolve(bvh, *pick);
         }
-        "bandai-namco"
+        table.name
     } else {
         match_by_name(bvh, &mut found, &mut warnings);
         "name-matched"
@@ -145,9 +138,10 @@ pub fn map_joints(bvh: &Bvh) -> Result<JointMap, BvhErrorKind> {
     let sources = found.map(|s| s.expect("checked above"));
     let used: Vec<usize> = sources
         .iter()
-        .filter_map(|s| match s {
-            JointSource::Joint(i) => Some(*i),
-            JointSource::Lerp { .. } => None,
+        .flat_map(|s| match *s {
+            JointSource::Joint(i) => vec![i],
+            JointSource::Between { a, b, .. } => vec![a, b],
+            JointSource::Lerp { .. } => vec![],
         })
         .collect();
     let unused = bvh
@@ -162,6 +156,30 @@ pub fn map_joints(bvh: &Bvh) -> Result<JointMap, BvhErrorKind> {
         sources,
         unused,
         warnings,
+    })
+}
+
+/// The source of a table pick (`None` if a name is missing: [`rigs::RigTable::fits`]
+/// checked them).
+fn resolve(bvh: &Bvh, pick: Pick) -> Option<JointSource> {
+    Some(match pick {
+        Pick::Joint(a) => JointSource::Joint(rigs::find_joint(bvh, a)?),
+        Pick::OneOf(names) => {
+            JointSource::Joint(names.iter().find_map(|a| rigs::find_joint(bvh, a))?)
+        }
+        Pick::Between(a, b, t) => JointSource::Between {
+            a: rigs::find_joint(bvh, a)?,
+            b: rigs::find_joint(bvh, b)?,
+            t,
+        },
+        Pick::End(a, t) => {
+            let a = rigs::find_joint(bvh, a)?;
+            JointSource::Between {
+                a,
+                b: rigs::end_site_of(bvh, a)?,
+                t,
+            }
+        }
     })
 }
 

@@ -1,10 +1,12 @@
 //! Length units and up axis of a BVH source.
 //!
 //! In: the 22 retargeted joints of a few frames, in file units. Out: the factor that
-//! turns file units into metres. Detection measures the body along its bones
-//! (ankle–knee–hip–pelvis–spine–neck–head, about 1.35 m for an adult, whatever the
-//! pose) and picks metres, centimetres or millimetres, whichever gives the most human
-//! size. Inches are never guessed (too close to centimetres); ask for them explicitly.
+//! turns file units into metres, taken from the skeleton itself: the leg measured along
+//! its bones (hip–knee–ankle, both sides, median over frames: bones are rigid, so any
+//! pose gives it). When metres, centimetres or millimetres make that leg human
+//! ([`HUMAN_LEG`]), that unit is kept, so real body sizes survive; otherwise (CMU's
+//! 1/0.45-inch units, inches, arbitrary exporter scales) the leg is scaled to
+//! [`TYPICAL_LEG`], an adult's.
 
 use crate::motion::Pose;
 use glam::Vec3;
@@ -69,8 +71,22 @@ const BODY_PATH: [(usize, usize); 8] = [
     (12, 15),
 ];
 
-/// Typical ankle-to-head bone-path length of an adult, metres.
-const TYPICAL_BODY_PATH: f32 = 1.35;
+/// Hip–knee–ankle length of HumanML3D's uniform skeleton (and of CMU's and HDM05's
+/// actors to 3 %), metres.
+pub const TYPICAL_LEG: f32 = 0.83;
+
+/// Leg lengths (metres) accepted as a human's in a standard unit: a small child to a
+/// very tall adult. Units differ by 100×, so only one can land here.
+pub const HUMAN_LEG: std::ops::RangeInclusive<f32> = 0.4..=1.3;
+
+/// How [`detect_scale`] chose its factor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ScaleFrom {
+    /// A standard unit (1, 0.01 or 0.001 m) made the leg human.
+    Unit,
+    /// No standard unit did: the leg was scaled to [`TYPICAL_LEG`].
+    LegLength,
+}
 
 /// Ankle-to-head length along the bones (left side), in the poses' units.
 pub fn body_path_length(pose: &Pose) -> f32 {
@@ -80,22 +96,29 @@ pub fn body_path_length(pose: &Pose) -> f32 {
         .sum()
 }
 
-/// Metres per file unit guessed from poses (median over the given frames).
-pub fn detect_scale(poses: &[Pose]) -> f32 {
-    let mut lengths: Vec<f32> = poses.iter().map(body_path_length).collect();
+/// Hip–knee–ankle length along the bones, mean of both legs, in the pose's units.
+pub fn leg_length(pose: &Pose) -> f32 {
+    let side = |hip: usize, knee: usize, ankle: usize| {
+        pose[hip].distance(pose[knee]) + pose[knee].distance(pose[ankle])
+    };
+    0.5 * (side(1, 4, 7) + side(2, 5, 8))
+}
+
+/// Metres per file unit from the skeleton's leg (median over the given frames).
+pub fn detect_scale(poses: &[Pose]) -> (f32, ScaleFrom) {
+    let mut lengths: Vec<f32> = poses.iter().map(leg_length).collect();
     lengths.sort_by(f32::total_cmp);
     let median = lengths.get(lengths.len() / 2).copied().unwrap_or(0.0);
-    if median <= 0.0 {
-        return 1.0;
+    if !(median.is_finite() && median > 0.0) {
+        return (1.0, ScaleFrom::Unit);
     }
-    [1.0f32, 0.01, 0.001]
+    match [1.0f32, 0.01, 0.001]
         .into_iter()
-        .min_by(|a, b| {
-            let da = (median * a / TYPICAL_BODY_PATH).ln().abs();
-            let db = (median * b / TYPICAL_BODY_PATH).ln().abs();
-            da.total_cmp(&db)
-        })
-        .expect("three candidates")
+        .find(|unit| HUMAN_LEG.contains(&(median * unit)))
+    {
+        Some(unit) => (unit, ScaleFrom::Unit),
+        None => (TYPICAL_LEG / median, ScaleFrom::LegLength),
+    }
 }
 
 #[cfg(test)]
@@ -107,11 +130,22 @@ mod tests {
     fn detects_metres_centimetres_millimetres() {
         let metres = rest_pose();
         let scaled = |s: f32| -> Vec<Pose> { vec![metres.map(|p| p * s)] };
-        assert_eq!(detect_scale(&scaled(1.0)), 1.0);
-        assert_eq!(detect_scale(&scaled(100.0)), 0.01);
-        assert_eq!(detect_scale(&scaled(1000.0)), 0.001);
+        assert_eq!(detect_scale(&scaled(1.0)), (1.0, ScaleFrom::Unit));
+        assert_eq!(detect_scale(&scaled(100.0)), (0.01, ScaleFrom::Unit));
+        assert_eq!(detect_scale(&scaled(1000.0)), (0.001, ScaleFrom::Unit));
         // A child (0.6 scale) in centimetres is still centimetres.
-        assert_eq!(detect_scale(&scaled(60.0)), 0.01);
+        assert_eq!(detect_scale(&scaled(60.0)), (0.01, ScaleFrom::Unit));
+    }
+
+    #[test]
+    fn other_units_take_the_scale_from_the_leg() {
+        // CMU units (1/0.45 inch ≈ 5.64 cm): the rest leg 0.826 m is 14.6 units.
+        let units = rest_pose().map(|p| p / 0.05644);
+        let (scale, from) = detect_scale(&[units]);
+        assert_eq!(from, ScaleFrom::LegLength);
+        let leg = leg_length(&units) * scale;
+        assert!((leg - TYPICAL_LEG).abs() < 1e-4, "{leg}");
+        assert!((scale - 0.05644).abs() < 0.002, "{scale}");
     }
 
     #[test]
