@@ -88,11 +88,17 @@ fn gelu_matches_the_erf_definition() {
         // A shared input takes the allocating path, a unique one is computed in place.
         let shared = values(gelu(input.clone()));
         let unique = values(gelu(input));
-        assert_eq!(shared, unique, "n={n}: in-place and allocating paths differ");
+        assert_eq!(
+            shared, unique,
+            "n={n}: in-place and allocating paths differ"
+        );
         for (&xi, &yi) in x.iter().zip(&unique) {
             let want = gelu_f64(xi as f64);
             let err = (yi as f64 - want).abs();
-            assert!(err <= 2e-6 * (1.0 + want.abs()), "gelu({xi}) = {yi}, want {want}");
+            assert!(
+                err <= 2e-6 * (1.0 + want.abs()),
+                "gelu({xi}) = {yi}, want {want}"
+            );
         }
     }
 }
@@ -125,7 +131,10 @@ fn exp_is_accurate_and_keeps_its_edges() {
         let shared_in = tensor(&x, &device);
         let shared = values(shared_in.clone().exp());
         let unique = values(shared_in.exp());
-        assert_eq!(shared, unique, "n={n}: in-place and allocating paths differ");
+        assert_eq!(
+            shared, unique,
+            "n={n}: in-place and allocating paths differ"
+        );
         for (&xi, &yi) in x.iter().zip(&unique) {
             let want = (xi as f64).exp();
             assert!(
@@ -158,10 +167,16 @@ fn softmax_rows_sum_to_one_and_match_f64() {
         for c in 0..cols {
             let want = (row[c] as f64 - max).exp() / sum;
             let got = y[r * cols + c] as f64;
-            assert!((got - want).abs() < 1e-6, "softmax[{r},{c}] = {got}, want {want}");
+            assert!(
+                (got - want).abs() < 1e-6,
+                "softmax[{r},{c}] = {got}, want {want}"
+            );
         }
     }
 }
+
+/// An op's name, what burn computed, and the f32 arithmetic it must equal.
+type Case = (&'static str, Vec<f32>, fn(f32, f32) -> f32);
 
 #[test]
 fn elementwise_arithmetic_is_exact_on_both_paths() {
@@ -170,7 +185,7 @@ fn elementwise_arithmetic_is_exact_on_both_paths() {
         let a = random(n, -3.0, 3.0, 50 + seed as u64);
         let b = random(n, 0.5, 3.0, 60 + seed as u64);
         let (ta, tb) = (tensor(&a, &device), tensor(&b, &device));
-        let cases: [(&str, Vec<f32>, fn(f32, f32) -> f32); 5] = [
+        let cases: [Case; 5] = [
             ("add", values(ta.clone() + tb.clone()), |x, y| x + y),
             ("sub", values(ta.clone() - tb.clone()), |x, y| x - y),
             ("mul", values(ta.clone() * tb.clone()), |x, y| x * y),
@@ -185,7 +200,11 @@ fn elementwise_arithmetic_is_exact_on_both_paths() {
         // In place (unique operands): the same numbers.
         let inplace = values(tensor(&a, &device) * tensor(&b, &device) + 2.0);
         for i in 0..n {
-            assert_eq!(inplace[i], a[i] * b[i] + 2.0, "in-place mul+add [{i}] (n={n})");
+            assert_eq!(
+                inplace[i],
+                a[i] * b[i] + 2.0,
+                "in-place mul+add [{i}] (n={n})"
+            );
         }
     }
 }
@@ -225,12 +244,18 @@ fn select_gradient_scatters_back_to_every_index() {
     );
     let loss = (input.clone().select(1, index) * up).sum();
     let grads = loss.backward();
-    let grad = input.grad(&grads).unwrap().into_data().try_into_vec::<f32>().unwrap();
+    let grad = input
+        .grad(&grads)
+        .unwrap()
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap();
     let mut want = vec![0.0f32; b * rows * c];
     for bi in 0..b {
         for (k, &r) in picks.iter().enumerate() {
             for ci in 0..c {
-                want[(bi * rows + r as usize) * c + ci] += upstream[(bi * picks.len() + k) * c + ci];
+                want[(bi * rows + r as usize) * c + ci] +=
+                    upstream[(bi * picks.len() + k) * c + ci];
             }
         }
     }
@@ -246,7 +271,11 @@ fn a_seeded_dropout_mask_repeats() {
     let device = Device::flex();
     let draw = || {
         device.seed(7);
-        values(Tensor::random([150_000], Distribution::Bernoulli(0.5), &device))
+        values(Tensor::random(
+            [150_000],
+            Distribution::Bernoulli(0.5),
+            &device,
+        ))
     };
     let (a, b) = (draw(), draw());
     assert_eq!(a, b, "the same seed gave two masks");

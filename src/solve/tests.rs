@@ -675,7 +675,9 @@ fn fused_and_graph_guidance_agree() {
         .zip(&graph.features)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f32::max);
-    assert!(worst < 1e-3, "fused and graph guidance differ by {worst}");
+    // 1e-3 before the burn-flex patch; its vectorised exp/GELU (relative error ~2e-7)
+    // sit on the graph path only, and 300 guided updates carry that to 1.4e-3.
+    assert!(worst < 2e-3, "fused and graph guidance differ by {worst}");
 }
 
 #[test]
