@@ -19,8 +19,8 @@ pub use nearest::{CaptionIndex, FAR_COSINE, Nearest};
 pub use normalize::basic_tokens;
 pub use tokenizer::{MAX_TOKENS, WordPiece};
 
+use super::weights::module_from_safetensors;
 use burn::prelude::*;
-use burn::store::{HalfPrecisionAdapter, ModuleSnapshot, SafetensorsStore};
 use std::path::{Path, PathBuf};
 
 /// Sentences per forward pass: bounds padding waste and the attention tensors' size.
@@ -110,7 +110,8 @@ impl SentenceEncoder {
         let weights_path = dir.join("encoder.safetensors");
         let bytes =
             std::fs::read(&weights_path).map_err(|e| SentenceError::read(&weights_path, e))?;
-        let bert = load_weights(Bert::new(&config, device), bytes)
+        // f16 on disk, every tensor checked against the config (the denoiser's loader).
+        let bert = module_from_safetensors(Bert::new(&config, device), bytes, true, "BERT encoder")
             .map_err(|reason| SentenceError::invalid(&weights_path, reason))?;
         Ok(SentenceEncoder {
             tokenizer,
@@ -178,25 +179,4 @@ impl SentenceEncoder {
         let mask = Tensor::<2>::from_data(TensorData::new(mask, [b, len]), &self.device);
         self.bert.embed(ids, mask)
     }
-}
-
-/// Loads f16 SafeTensors bytes over `bert`; every tensor must be there with its shape.
-fn load_weights(mut bert: Bert, bytes: Vec<u8>) -> Result<Bert, String> {
-    let mut store =
-        SafetensorsStore::from_bytes(Some(bytes)).with_from_adapter(HalfPrecisionAdapter::new());
-    let result = bert.load_from(&mut store).map_err(|e| {
-        let text: String = e.to_string().chars().take(400).collect();
-        format!("weights do not fit the BERT config: {text}")
-    })?;
-    if !result.errors.is_empty() || !result.missing.is_empty() {
-        let first = |v: Vec<String>| v.into_iter().take(3).collect::<Vec<_>>().join("; ");
-        return Err(format!(
-            "weights do not fit the BERT config: {} errors ({}), {} missing tensors ({})",
-            result.errors.len(),
-            first(result.errors.iter().map(|e| format!("{e:?}")).collect()),
-            result.missing.len(),
-            first(result.missing.iter().map(|m| format!("{m:?}")).collect()),
-        ));
-    }
-    Ok(bert)
 }
