@@ -93,7 +93,10 @@ fn main() -> miette::Result<()> {
         Command::Score(args) => cli::score::run(args)?,
         Command::Run(args) => cli::run::run(args)?,
         Command::Repl(args) => cli::repl::run(args)?,
-        Command::Prompt => print!("{}", mprog::docgen::prompt::system_prompt()),
+        Command::Prompt => print!(
+            "{}",
+            mprog::docgen::prompt::system_prompt_for(&mprog::model::weights::shipped_actions())
+        ),
         Command::Doc(cmd) => cli::doc::run(cmd)?,
         Command::Check(args) => {
             if !cli::check::run(&args)? {

@@ -12,6 +12,7 @@ use mprog::formats::json::read_json_str;
 use mprog::formats::npy::{classify, read_npy_bytes};
 use mprog::formats::{LoadedMotion, read_motion};
 use mprog::lang::{EvalError, MAX_EVAL_ELEMENTS, check_source, compile};
+use mprog::model::prompt::PromptEncoder;
 use mprog::model::text::Vocabulary;
 use mprog::model::weights::Manifest;
 use mprog::model::{Mdm, ModelBundle, ModelConfig};
@@ -170,6 +171,7 @@ fn tiny_config() -> ModelConfig {
         d_ff: 32,
         dropout: 0.0,
         d_text: 8,
+        text_encoder: Default::default(),
         max_frames: 40,
         input_skip: false,
     }
@@ -183,7 +185,7 @@ fn tiny_bundle(dir: &Path) {
     let model = Mdm::new(&config, vocab.len(), &device);
     let bundle = ModelBundle {
         config,
-        vocab,
+        text: PromptEncoder::Words(vocab),
         mean: vec![0.0; 263],
         std: vec![1.0; 263],
         model,
@@ -193,6 +195,7 @@ fn tiny_bundle(dir: &Path) {
             steps: 0,
             train_seconds: 0.0,
             half_precision: false,
+            text_encoder_id: None,
         },
     };
     bundle.save(dir).unwrap();

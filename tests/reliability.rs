@@ -4,6 +4,7 @@
 //! * Ctrl-C (SIGINT) stops training with a checkpoint and generation with no output.
 
 use burn::tensor::Device;
+use mprog::model::prompt::PromptEncoder;
 use mprog::model::text::Vocabulary;
 use mprog::model::weights::{BUNDLE_VERSION, Manifest};
 use mprog::model::{Mdm, ModelBundle, ModelConfig, TrainConfig};
@@ -40,6 +41,7 @@ fn model_config(d_model: usize, layers: usize) -> ModelConfig {
         d_ff: 2 * d_model,
         dropout: 0.1,
         d_text: 8,
+        text_encoder: Default::default(),
         max_frames: 40,
         input_skip: false,
     }
@@ -51,7 +53,7 @@ fn bundle(dir: &Path, config: ModelConfig) {
     let model = Mdm::new(&config, vocab.len(), &Device::flex());
     ModelBundle {
         config,
-        vocab,
+        text: PromptEncoder::Words(vocab),
         mean: (0..263).map(|i| 0.01 * i as f32).collect(),
         std: vec![0.5; 263],
         model,
@@ -61,6 +63,7 @@ fn bundle(dir: &Path, config: ModelConfig) {
             steps: 0,
             train_seconds: 0.0,
             half_precision: true,
+            text_encoder_id: None,
         },
     }
     .save(dir)

@@ -4,9 +4,10 @@ use burn::prelude::*;
 use miette::Result;
 use mprog::model::denoiser::{Denoiser, DenoiserInput, Mdm};
 use mprog::model::noise::NoiseSource;
+use mprog::model::prompt::PromptEncoder;
 use mprog::model::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
 use mprog::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
-use mprog::model::text::{TokenBatch, Vocabulary};
+use mprog::model::text::Vocabulary;
 use mprog::model::{ModelBundle, ModelConfig};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -74,15 +75,19 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
         .model
         .clone()
         .unwrap_or_else(mprog::model::weights::default_model_dir);
-    let (config, vocab, model) = match ModelBundle::load(&dir, &plain) {
-        Ok(b) => (b.config, b.vocab, b.model),
+    let (config, text, model) = match ModelBundle::load(&dir, &plain) {
+        Ok(b) => (b.config, b.text, b.model),
         Err(e) => {
             eprintln!("({e}; timing the default config with random weights)");
             let config = ModelConfig::default();
             let vocab = Vocabulary::from_captions(["a person walks forward"], 16);
             let model = Mdm::new(&config, vocab.len(), &plain);
-            (config, vocab, model)
+            (config, PromptEncoder::Words(vocab), model)
         }
+    };
+    let vocab_size = match &text {
+        PromptEncoder::Words(v) => v.len(),
+        PromptEncoder::Sentences(_) => 0,
     };
     let n = args.frames;
     println!(
@@ -98,7 +103,7 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
     let input = |b: usize, dev: &Device| DenoiserInput {
         x_t: NoiseSource::new(1).tensor([b, n, config.features], dev),
         timesteps: vec![500; b],
-        tokens: TokenBatch::new(&vocab, &vec!["a person walks forward"; b], dev),
+        text: text.batch(&vec!["a person walks forward"; b], dev),
         keep_text: Tensor::ones([b], dev),
         padding: None,
     };
@@ -119,7 +124,7 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
     let ad = plain.clone().autodiff();
     // A fresh training module: loaded weights do not track gradients, and timing does
     // not depend on the values.
-    let train = Mdm::new(&config, vocab.len(), &ad);
+    let train = Mdm::new(&config, vocab_size, &ad);
     let fb: Vec<f64> = [1, 32]
         .iter()
         .map(|&b| {
@@ -139,7 +144,7 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
         fb[0], fb[1]
     );
     let base = NoiseSchedule::cosine(DIFFUSION_STEPS);
-    let cond = Condition::new(&vocab, &["a person walks forward"], 2.5, &plain);
+    let cond = Condition::new(&text, &["a person walks forward"], 2.5, &plain);
     for steps in [50, 100] {
         let kind = SamplerKind::Ddim(steps);
         let s = schedule_for(&base, kind);

@@ -48,7 +48,7 @@ fn book(dir: &std::path::Path, programs: &std::path::Path, check: bool) -> Resul
         .wrap_err_with(|| format!("reading {}", summary_path.display()))?;
     let new_summary = summary_with_cookbook(&summary, &progs)
         .ok_or_else(|| miette!("{} has no cookbook markers", summary_path.display()))?;
-    let mut files = pages(&progs, dir);
+    let mut files = pages(&progs, dir, &mprog::model::weights::shipped_actions());
     files.push((PathBuf::from("SUMMARY.md"), new_summary));
     let mut stale = 0;
     for (rel, text) in files {

@@ -126,7 +126,7 @@ pub fn run(args: GenArgs) -> Result<()> {
             report.slide_after * 1000.0
         );
     }
-    for line in bundle.vocab.word_report(&args.text) {
+    for line in bundle.text.report(&args.text) {
         eprintln!("{line}");
     }
     let mut meta = Meta::new();

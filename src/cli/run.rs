@@ -163,7 +163,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
     let several = prompts.len() > 1;
     for (person, prompt) in program.people().iter().zip(&prompts) {
-        for line in bundle.vocab.word_report(prompt) {
+        for line in bundle.text.report(prompt) {
             if several {
                 eprintln!("{}: {line}", person.name);
             } else {

@@ -107,6 +107,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         init_from: args.init_from.clone(),
         device: super::device()?,
         after_checkpoint: Some(plot_loss_curves),
+        text_encoder: None,
     };
     // The log's s/step is wall time over the last logged steps (checkpoints included), not
     // the run's lifetime mean, which carries every earlier session's speed.

@@ -123,8 +123,19 @@ Joints are points inside the body, not its surface:
 
 /// The full system prompt, in markdown.
 pub fn system_prompt() -> String {
+    system_prompt_for(&[])
+}
+
+/// Fewest training clips for an action to be listed on the card: rarer ones are single
+/// takes the model has seen too little of to repeat.
+pub const LISTED_ACTION_CLIPS: usize = 3;
+
+/// The card for a model trained on `actions` (caption, training clips; from the bundle's
+/// `actions.json`, most clips first): the card above plus what the motion model knows.
+pub fn system_prompt_for(actions: &[(String, usize)]) -> String {
     let mut s = String::new();
     s.push_str(INTRO);
+    s.push_str(&actions_section(actions));
     s.push_str("\n## Joints\n\nJoints are named by canonical name or alias (case-insensitive); these 22 are all there are.\n\n");
     s.push_str(&joints_section());
     s.push_str("\n## Library (built-ins first, then functions written in mprog)\n\n");
@@ -140,6 +151,31 @@ pub fn system_prompt() -> String {
         ));
     }
     s.push_str(RULES);
+    s
+}
+
+/// "What the motion model knows", generated from the training captions so it cannot drift
+/// from the weights; empty without an action list.
+fn actions_section(actions: &[(String, usize)]) -> String {
+    let listed: Vec<&(String, usize)> = actions
+        .iter()
+        .filter(|(_, n)| *n >= LISTED_ACTION_CLIPS)
+        .collect();
+    if listed.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "\n## What the motion model knows\n\n\
+         The `prompt` is read by a sentence encoder, so any wording is understood, but the\n\
+         model only moves as its training clips did. These are the actions it was trained on\n\
+         (training clips in brackets; style words such as \"tired\", \"happy\" or \"old\" combine\n\
+         with the walks, runs, waves and hand raises). Prompt one of them, or a plain\n\
+         paraphrase; for anything else let the constraints carry the motion. `mprog check`\n\
+         warns when a prompt is far from all of them.\n\n",
+    );
+    for (caption, n) in listed {
+        s.push_str(&format!("- {caption} ({n})\n"));
+    }
     s
 }
 

@@ -60,6 +60,25 @@ pub fn check_source(source: &str, name: &str, overrides: &[(String, f64)]) -> Di
     }
 }
 
+/// The prompts a program gives (its `prompt` line, and each person's on a `people`
+/// line) with where they are written; empty when the program does not parse.
+pub fn prompts_of(source: &str) -> Vec<(String, syntax::ast::Span)> {
+    let (module, _) = syntax::source_to_ast(source);
+    let mut out = Vec::new();
+    for item in &module.items {
+        match item {
+            syntax::ast::Item::Prompt { text, span } => out.push((text.clone(), *span)),
+            syntax::ast::Item::People { people, span } => out.extend(
+                people
+                    .iter()
+                    .filter_map(|p| p.prompt.clone().map(|t| (t, *span))),
+            ),
+            _ => {}
+        }
+    }
+    out
+}
+
 /// Parses, checks and lowers a program. `overrides` replace `param` defaults (values in the
 /// unit the default was written in). Errors come back as [`Diagnostics`].
 pub fn compile(

@@ -11,6 +11,7 @@ use crate::dataset::stats::feature_stats;
 use crate::dataset::{ClipInfo, Dataset, DatasetIndex, FEATURE_DIM, Split, SplitStats};
 use crate::features::{ExtractOptions, extract};
 use crate::model::config::ModelConfig;
+use crate::model::prompt::PromptEncoder;
 use crate::model::sampler::SamplerKind;
 use crate::model::text::Vocabulary;
 use crate::model::weights::{BUNDLE_VERSION, Manifest};
@@ -251,6 +252,7 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
         heads: 2,
         d_ff: 64,
         d_text: 8,
+        text_encoder: Default::default(),
         max_frames: 50,
         input_skip: false,
         ..ModelConfig::default()
@@ -265,7 +267,7 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
     ModelBundle {
         model: Mdm::new(&config, vocab.len(), dev),
         config,
-        vocab,
+        text: PromptEncoder::Words(vocab),
         mean: data.mean.clone(),
         std: data.std.clone(),
         manifest: Manifest {
@@ -274,6 +276,7 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
             steps: 0,
             train_seconds: 0.0,
             half_precision: false,
+            text_encoder_id: None,
         },
     }
 }

@@ -51,12 +51,39 @@ pub fn drop_words(caption: &str, p: f64, rng: &mut impl Rng) -> String {
     }
 }
 
+/// Sampling weight of a clip under `cfg.source_weights` (longest matching prefix, else 1).
+pub fn clip_weight(cfg: &TrainConfig, clip: &ClipInfo) -> f64 {
+    cfg.source_weights
+        .iter()
+        .filter(|(prefix, _)| clip.source.starts_with(prefix.as_str()))
+        .max_by_key(|(prefix, _)| prefix.len())
+        .map_or(1.0, |(_, &w)| w)
+}
+
 /// Draws the batch of `step`.
 pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: usize) -> HostBatch {
     let mut rng = step_rng(cfg.seed, step);
+    // Cumulative weights; without source weights the draw is the plain uniform one (the
+    // same data order as runs made before weights existed).
+    let cumulative: Option<Vec<f64>> = (!cfg.source_weights.is_empty()).then(|| {
+        clips
+            .iter()
+            .scan(0.0, |acc, c| {
+                *acc += clip_weight(cfg, c);
+                Some(*acc)
+            })
+            .collect()
+    });
     let picks: Vec<(&ClipInfo, usize, usize)> = (0..cfg.batch_size)
         .map(|_| {
-            let clip = clips[rng.random_range(0..clips.len())];
+            let index = match &cumulative {
+                None => rng.random_range(0..clips.len()),
+                Some(cum) => {
+                    let u = rng.random::<f64>() * cum[cum.len() - 1];
+                    cum.partition_point(|&c| c <= u).min(clips.len() - 1)
+                }
+            };
+            let clip = clips[index];
             let len = clip.frames.min(cfg.crop_frames);
             let start = rng.random_range(0..=clip.frames - len);
             (clip, start, len)

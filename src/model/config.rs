@@ -20,8 +20,12 @@ pub struct ModelConfig {
     /// Dropout in training.
     #[serde(default = "default_dropout")]
     pub dropout: f64,
-    /// Width of the word embeddings of the text encoder.
+    /// Width of the text vector fed to the condition token: the word embeddings of the
+    /// bag-of-words encoder, or the sentence encoder's output (384 for MiniLM).
     pub d_text: usize,
+    /// Which text encoder reads the prompts. Bundles without the field are bag-of-words.
+    #[serde(default, skip_serializing_if = "TextEncoderKind::is_bag_of_words")]
+    pub text_encoder: TextEncoderKind,
     /// Longest motion the model is asked for (frames).
     pub max_frames: usize,
     /// Add a learned, timestep-gated copy of the input to the output (`x̂0 = F(x_t) +
@@ -30,6 +34,25 @@ pub struct ModelConfig {
     /// columns (the root's yaw rate) badly. Bundles without it load as before.
     #[serde(default, skip_serializing_if = "is_false")]
     pub input_skip: bool,
+}
+
+/// The text encoder of a denoiser.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TextEncoderKind {
+    /// Mean of word embeddings learned with the denoiser over the training vocabulary.
+    #[default]
+    #[serde(rename = "bag-of-words")]
+    BagOfWords,
+    /// The frozen pretrained sentence encoder (all-MiniLM-L6-v2, `models/text-encoder`):
+    /// open vocabulary, one 384-d unit vector per prompt.
+    #[serde(rename = "minilm")]
+    Sentence,
+}
+
+impl TextEncoderKind {
+    fn is_bag_of_words(&self) -> bool {
+        *self == TextEncoderKind::BagOfWords
+    }
 }
 
 fn is_false(b: &bool) -> bool {
@@ -53,6 +76,7 @@ impl Default for ModelConfig {
             d_ff: 1024,
             dropout: 0.1,
             d_text: 128,
+            text_encoder: TextEncoderKind::BagOfWords,
             max_frames: 196,
             input_skip: false,
         }
@@ -102,6 +126,12 @@ pub struct TrainConfig {
     /// "a person walks" was a word set the bag-of-words encoder never saw, and stood still.
     #[serde(default)]
     pub word_drop: f64,
+    /// Sampling weight of clips by source folder: a clip whose `source` path starts with a
+    /// key is drawn that many times as often as one with weight 1 (the longest matching key
+    /// wins; clips matching none weigh 1). A few minutes of jumps and kicks next to hours of
+    /// walking are otherwise seen too rarely to be learned.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub source_weights: std::collections::BTreeMap<String, f64>,
     /// Seed of the data order and noise.
     pub seed: u64,
 }
@@ -124,6 +154,7 @@ impl Default for TrainConfig {
             velocity_loss: 0.0,
             root_loss: 0.0,
             word_drop: 0.0,
+            source_weights: Default::default(),
             seed: 1,
         }
     }
@@ -194,6 +225,13 @@ impl TrainConfig {
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("`{name}` is {v}; it must be zero or positive"));
+            }
+        }
+        for (prefix, w) in &self.source_weights {
+            if !(w.is_finite() && *w > 0.0 && *w <= 1e6) {
+                return Err(format!(
+                    "`source_weights` of \"{prefix}\" is {w}; it must be a positive number"
+                ));
             }
         }
         fraction("cond_drop", self.cond_drop, false)?;

@@ -5,8 +5,9 @@
 //! N frame tokens, sinusoidal positions added to all N+1, post-norm encoder layers, the
 //! condition token dropped at the output.
 
-use super::config::ModelConfig;
-use super::text::{BagOfWords, TextEncoder, TokenBatch};
+use super::config::{ModelConfig, TextEncoderKind};
+use super::prompt::TextBatch;
+use super::text::{BagOfWords, TextEncoder};
 use burn::nn::transformer::{
     TransformerEncoder, TransformerEncoderConfig, TransformerEncoderInput,
 };
@@ -21,8 +22,8 @@ pub struct DenoiserInput {
     pub x_t: Tensor<3>,
     /// Original-schedule timestep of each sample.
     pub timesteps: Vec<usize>,
-    /// Tokenised prompts, one per sample.
-    pub tokens: TokenBatch,
+    /// The prompts, one per sample, as the model's text encoder reads them.
+    pub text: TextBatch,
     /// `[B]` 1.0 keeps the text condition, 0.0 drops it (unconditional pass).
     pub keep_text: Tensor<1>,
     /// `[B, N]` true on padded frames.
@@ -41,7 +42,8 @@ pub struct Mdm {
     input_proj: Linear,
     time_1: Linear,
     time_2: Linear,
-    text: BagOfWords,
+    /// The bag-of-words encoder; None when the model reads sentence vectors.
+    text: Option<BagOfWords>,
     text_proj: Linear,
     encoder: TransformerEncoder,
     output_proj: Linear,
@@ -74,14 +76,16 @@ fn sinusoids(positions: impl Iterator<Item = usize>, d: usize, device: &Device) 
 }
 
 impl Mdm {
-    /// A freshly initialised denoiser for a vocabulary of `vocab_size` ids.
+    /// A freshly initialised denoiser; `vocab_size` ids for a bag-of-words text encoder
+    /// (unused with sentence vectors).
     pub fn new(config: &ModelConfig, vocab_size: usize, device: &Device) -> Self {
         let d = config.d_model;
         Mdm {
             input_proj: LinearConfig::new(config.features, d).init(device),
             time_1: LinearConfig::new(d, d).init(device),
             time_2: LinearConfig::new(d, d).init(device),
-            text: BagOfWords::new(vocab_size, config.d_text, device),
+            text: (config.text_encoder == TextEncoderKind::BagOfWords)
+                .then(|| BagOfWords::new(vocab_size, config.d_text, device)),
             text_proj: LinearConfig::new(config.d_text, d).init(device),
             encoder: TransformerEncoderConfig::new(d, config.d_ff, config.heads, config.layers)
                 .with_dropout(config.dropout)
@@ -117,7 +121,11 @@ impl Mdm {
     fn condition(&self, input: &DenoiserInput, device: &Device) -> Tensor<2> {
         let t = sinusoids(input.timesteps.iter().copied(), self.d_model, device);
         let t = self.time_2.forward(silu(self.time_1.forward(t)));
-        let text = self.text.encode(&input.tokens); // [B, d_text]
+        let text = match (&self.text, &input.text) {
+            (Some(bag), TextBatch::Words(tokens)) => bag.encode(tokens),
+            (None, TextBatch::Sentences(s)) => s.vectors.clone(),
+            _ => unreachable!("the bundle's prompt encoder matches its denoiser"),
+        }; // [B, d_text]
         let text = text * input.keep_text.clone().unsqueeze_dim::<2>(1);
         t + self.text_proj.forward(text)
     }

@@ -112,7 +112,7 @@ pub fn generate_interruptible(
     }
     let model = bundle.model.valid();
     let prompts: Vec<&str> = req.prompts.iter().map(String::as_str).collect();
-    let cond = Condition::new(&bundle.vocab, &prompts, req.guidance_scale, device);
+    let cond = Condition::new(&bundle.text, &prompts, req.guidance_scale, device);
     let schedule = schedule_for(&NoiseSchedule::cosine(DIFFUSION_STEPS), req.sampler);
     let x_t = initial_noise(req, bundle.config.features, device);
     let mut noise = NoiseSource::new(req.seed ^ 0x5DEE_CE66);
@@ -125,7 +125,7 @@ pub fn generate_interruptible(
     let stop = || interrupt.is_requested();
     let averaged;
     let den: &dyn Denoiser = if req.mirror_average {
-        averaged = MirrorAveraged::new(model, &bundle.vocab, &bundle.mean, &bundle.std, device);
+        averaged = MirrorAveraged::new(model, &bundle.text, &bundle.mean, &bundle.std, device);
         &averaged
     } else {
         &model

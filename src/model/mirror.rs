@@ -15,12 +15,10 @@
 //! halves run as one batch, so the cost is one denoiser call at twice the batch.
 
 use super::denoiser::{Denoiser, DenoiserInput};
+use super::prompt::{PromptEncoder, SIDE_WORDS, SentenceBatch, TextBatch};
 use super::text::{TokenBatch, Vocabulary};
 use crate::features::{FEATURE_DIM, FeatureMirror};
 use burn::prelude::*;
-
-/// Caption words that name a side, swapped in the mirrored question.
-const SIDE_WORDS: [(&str, &str); 2] = [("left", "right"), ("clockwise", "counterclockwise")];
 
 /// A [`Denoiser`] averaged with its left/right mirror.
 #[derive(Clone, Debug)]
@@ -37,8 +35,20 @@ pub struct MirrorAveraged<D> {
 
 impl<D: Denoiser> MirrorAveraged<D> {
     /// Wraps `inner`, whose inputs are normalised with `mean` / `std` and whose text is
-    /// tokenised with `vocab`.
-    pub fn new(inner: D, vocab: &Vocabulary, mean: &[f32], std: &[f32], device: &Device) -> Self {
+    /// read with `prompts`.
+    pub fn new(
+        inner: D,
+        prompts: &PromptEncoder,
+        mean: &[f32],
+        std: &[f32],
+        device: &Device,
+    ) -> Self {
+        let empty = Vocabulary::default();
+        let vocab = match prompts {
+            PromptEncoder::Words(vocab) => vocab,
+            // Sentence batches carry their mirrored vectors; no ids to map.
+            PromptEncoder::Sentences(_) => &empty,
+        };
         let mirror = FeatureMirror::humanml3d();
         let (scale, shift) = mirror.normalized(mean, std);
         let source: Vec<i64> = mirror.source.iter().map(|&i| i as i64).collect();
@@ -77,13 +87,16 @@ impl<D: Denoiser> Denoiser for MirrorAveraged<D> {
         let both = DenoiserInput {
             x_t: Tensor::cat(vec![input.x_t.clone(), self.mirror(input.x_t.clone())], 0),
             timesteps: [input.timesteps.as_slice(), input.timesteps.as_slice()].concat(),
-            tokens: TokenBatch {
-                ids: Tensor::cat(
-                    vec![input.tokens.ids.clone(), self.mirror_ids(&input.tokens)],
-                    0,
-                ),
-                mask: Tensor::cat(vec![input.tokens.mask.clone(); 2], 0),
-                unknown: [input.tokens.unknown.as_slice(); 2].concat(),
+            text: match &input.text {
+                TextBatch::Words(tokens) => TextBatch::Words(TokenBatch {
+                    ids: Tensor::cat(vec![tokens.ids.clone(), self.mirror_ids(tokens)], 0),
+                    mask: Tensor::cat(vec![tokens.mask.clone(); 2], 0),
+                    unknown: [tokens.unknown.as_slice(); 2].concat(),
+                }),
+                TextBatch::Sentences(s) => TextBatch::Sentences(SentenceBatch {
+                    vectors: Tensor::cat(vec![s.vectors.clone(), s.mirrored.clone()], 0),
+                    mirrored: Tensor::cat(vec![s.mirrored.clone(), s.vectors.clone()], 0),
+                }),
             },
             keep_text: Tensor::cat(vec![input.keep_text.clone(), input.keep_text.clone()], 0),
             padding: input
@@ -123,7 +136,7 @@ mod tests {
         DenoiserInput {
             x_t,
             timesteps: vec![300; b],
-            tokens: TokenBatch::new(&vocab(), &vec![prompt; b], dev),
+            text: TextBatch::Words(TokenBatch::new(&vocab(), &vec![prompt; b], dev)),
             keep_text: Tensor::ones([b], dev),
             padding: None,
         }
@@ -145,7 +158,7 @@ mod tests {
     fn a_symmetric_denoiser_is_unchanged() {
         let dev = Device::flex();
         let (mean, std) = stats();
-        let avg = MirrorAveraged::new(Identity, &vocab(), &mean, &std, &dev);
+        let avg = MirrorAveraged::new(Identity, &PromptEncoder::Words(vocab()), &mean, &std, &dev);
         let x = NoiseSource::new(1).tensor([2, 5, FEATURE_DIM], &dev);
         let out = avg.predict_x0(&question("someone turns left", x.clone(), &dev));
         assert!(max_diff(out, x.clone()) < 1e-5);
@@ -163,6 +176,7 @@ mod tests {
             d_ff: 64,
             dropout: 0.0,
             d_text: 8,
+            text_encoder: Default::default(),
             max_frames: 40,
             input_skip: false,
         };
@@ -170,7 +184,13 @@ mod tests {
         let (mean, std) = stats();
         let x = NoiseSource::new(2).tensor([1, 6, FEATURE_DIM], &dev);
         // The bare network is not symmetric ...
-        let plain = MirrorAveraged::new(net.clone(), &vocab(), &mean, &std, &dev);
+        let plain = MirrorAveraged::new(
+            net.clone(),
+            &PromptEncoder::Words(vocab()),
+            &mean,
+            &std,
+            &dev,
+        );
         let left = net.predict_x0(&question("turns left", x.clone(), &dev));
         let right_of_mirror =
             net.predict_x0(&question("turns right", plain.mirror(x.clone()), &dev));
@@ -186,7 +206,13 @@ mod tests {
         let dev = Device::flex();
         let v = vocab();
         let (mean, std) = stats();
-        let avg = MirrorAveraged::new(Identity, &v, &mean, &std, &dev);
+        let avg = MirrorAveraged::new(
+            Identity,
+            &PromptEncoder::Words(v.clone()),
+            &mean,
+            &std,
+            &dev,
+        );
         let swapped = avg.mirror_ids(&TokenBatch::new(&v, &["someone turns left"], &dev));
         let expected = TokenBatch::new(&v, &["someone turns right"], &dev);
         assert_eq!(

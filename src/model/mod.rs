@@ -10,6 +10,7 @@ pub mod ema;
 pub mod generate;
 pub mod mirror;
 pub mod noise;
+pub mod prompt;
 pub mod sampler;
 pub mod schedule;
 pub mod sentence;
@@ -21,5 +22,7 @@ pub use config::{ModelConfig, TrainConfig};
 pub use denoiser::{Denoiser, DenoiserInput, Mdm};
 pub use weights::ModelBundle;
 
+#[cfg(test)]
+mod sentence_model_tests;
 #[cfg(test)]
 mod tests;

@@ -3,8 +3,8 @@
 
 use super::denoiser::{Denoiser, DenoiserInput};
 use super::noise::NoiseSource;
+use super::prompt::{PromptEncoder, TextBatch};
 use super::schedule::NoiseSchedule;
-use super::text::{TokenBatch, Vocabulary};
 use burn::prelude::*;
 
 /// Which chain to run.
@@ -16,26 +16,37 @@ pub enum SamplerKind {
     Ddpm(usize),
 }
 
-/// The text condition of a batch, tokenised once and reused at every step.
+/// The text condition of a batch, encoded once and reused at every step.
 #[derive(Clone, Debug)]
 pub struct Condition {
     /// Prompts then the same prompts again (the unconditional half), when guided.
-    pub tokens: TokenBatch,
+    pub text: TextBatch,
+    /// Words of each prompt that the model cannot read.
+    unknown: Vec<Vec<String>>,
     /// Classifier-free guidance scale (1 = plain conditional model).
     pub guidance_scale: f32,
     batch: usize,
 }
 
 impl Condition {
-    /// Tokenises `prompts` (one per sample).
-    pub fn new(vocab: &Vocabulary, prompts: &[&str], guidance_scale: f32, device: &Device) -> Self {
-        let doubled: Vec<&str> = if guidance_scale != 1.0 {
-            prompts.iter().chain(prompts.iter()).copied().collect()
-        } else {
-            prompts.to_vec()
-        };
+    /// Encodes `prompts` (one per sample).
+    pub fn new(
+        prompts_encoder: &PromptEncoder,
+        prompts: &[&str],
+        guidance_scale: f32,
+        device: &Device,
+    ) -> Self {
+        let text = prompts_encoder.batch(prompts, device);
         Condition {
-            tokens: TokenBatch::new(vocab, &doubled, device),
+            text: if guidance_scale != 1.0 {
+                text.doubled()
+            } else {
+                text
+            },
+            unknown: prompts
+                .iter()
+                .map(|p| prompts_encoder.unknown_words(p))
+                .collect(),
             guidance_scale,
             batch: prompts.len(),
         }
@@ -43,7 +54,7 @@ impl Condition {
 
     /// Words of each prompt that the model does not know.
     pub fn unknown_words(&self) -> &[Vec<String>] {
-        &self.tokens.unknown[..self.batch]
+        &self.unknown
     }
 }
 
@@ -60,7 +71,7 @@ pub fn guided_x0(
         let input = DenoiserInput {
             x_t,
             timesteps: vec![timestep; b],
-            tokens: cond.tokens.clone(),
+            text: cond.text.clone(),
             keep_text: Tensor::ones([b], &device),
             padding: None,
         };
@@ -70,7 +81,7 @@ pub fn guided_x0(
     let input = DenoiserInput {
         x_t: Tensor::cat(vec![x_t.clone(), x_t], 0),
         timesteps: vec![timestep; 2 * b],
-        tokens: cond.tokens.clone(),
+        text: cond.text.clone(),
         keep_text: Tensor::from_data(TensorData::new(keep, [2 * b]), &device),
         padding: None,
     };

@@ -4,6 +4,7 @@
 use super::config::{ModelConfig, TrainConfig};
 use super::denoiser::{Denoiser, DenoiserInput, Mdm};
 use super::noise::NoiseSource;
+use super::prompt::{PromptEncoder, TextBatch};
 use super::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
 use super::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use super::text::{TokenBatch, Vocabulary};
@@ -12,7 +13,7 @@ use super::weights::{model_from_safetensors, model_to_safetensors};
 use crate::dataset::{ClipInfo, Dataset, DatasetIndex, FEATURE_DIM, Split, SplitStats};
 use burn::prelude::*;
 
-fn tiny() -> ModelConfig {
+pub(super) fn tiny() -> ModelConfig {
     ModelConfig {
         features: FEATURE_DIM,
         d_model: 32,
@@ -21,6 +22,7 @@ fn tiny() -> ModelConfig {
         d_ff: 64,
         dropout: 0.1,
         d_text: 8,
+        text_encoder: Default::default(),
         max_frames: 40,
         input_skip: false,
     }
@@ -35,7 +37,7 @@ fn input(b: usize, n: usize, dev: &Device) -> DenoiserInput {
     DenoiserInput {
         x_t: NoiseSource::new(3).tensor([b, n, FEATURE_DIM], dev),
         timesteps: vec![500; b],
-        tokens: TokenBatch::new(&vocab(), &prompts, dev),
+        text: TextBatch::Words(TokenBatch::new(&vocab(), &prompts, dev)),
         keep_text: Tensor::ones([b], dev),
         padding: None,
     }
@@ -89,7 +91,12 @@ fn ddim_is_deterministic_from_the_seed() {
     let base = NoiseSchedule::cosine(DIFFUSION_STEPS);
     let kind = SamplerKind::Ddim(5);
     let s = schedule_for(&base, kind);
-    let cond = Condition::new(&vocab(), &["a person walks"], 2.5, &dev);
+    let cond = Condition::new(
+        &PromptEncoder::Words(vocab()),
+        &["a person walks"],
+        2.5,
+        &dev,
+    );
     let run = |seed| {
         let x = NoiseSource::new(seed).tensor([1, 8, FEATURE_DIM], &dev);
         sample_chain(
@@ -110,7 +117,7 @@ fn ddim_is_deterministic_from_the_seed() {
 }
 
 /// A dataset of two synthetic "clips": smooth sinusoids with a caption each.
-fn synthetic_dataset() -> Dataset {
+pub(super) fn synthetic_dataset() -> Dataset {
     let frames = 24;
     let mut features = Vec::new();
     for c in 0..2 {
@@ -174,6 +181,7 @@ fn training_learns_and_resumes_from_checkpoints() {
         init_from: None,
         device: Device::flex(),
         after_checkpoint: Some(mark_checkpoint),
+        text_encoder: None,
     };
     let first = run(30).run(&|_, _, _| {}).unwrap();
     assert_eq!(first.step, 30);
@@ -224,6 +232,7 @@ fn interrupted_training_saves_a_checkpoint_and_resumes() {
         init_from: None,
         device: Device::flex(),
         after_checkpoint: None,
+        text_encoder: None,
     };
     // Ctrl-C arrives during step 4, between checkpoints (every 10 steps).
     let stopped = run
@@ -283,6 +292,7 @@ fn a_new_run_can_start_from_a_bundle() {
         init_from: init,
         device: Device::flex(),
         after_checkpoint: None,
+        text_encoder: None,
     };
     run(first.path(), None, 5).run(&|_, _, _| {}).unwrap();
     let second = tempfile::tempdir().unwrap();
@@ -320,6 +330,7 @@ fn a_run_with_input_skip_can_start_from_a_bundle_without_it() {
         init_from: init,
         device: Device::flex(),
         after_checkpoint: None,
+        text_encoder: None,
     };
     run(first.path(), &config, None, 5)
         .run(&|_, _, _| {})

@@ -1,16 +1,24 @@
 //! A model bundle on disk: weights (SafeTensors, f16 for shipping, f32 for checkpoints),
-//! config, vocabulary and normalisation statistics, with version and shape checks.
+//! config, text side and normalisation statistics, with version and shape checks.
 //!
 //! ```text
 //! <dir>/manifest.json      format version, weights id, training summary
 //! <dir>/config.toml        ModelConfig
-//! <dir>/vocab.json         Vocabulary
+//! <dir>/vocab.json         Vocabulary (bag-of-words models)
+//! <dir>/captions.safetensors  training captions, embedded (sentence-encoder models)
+//! <dir>/actions.json       what the training clips show, with clip counts (optional)
 //! <dir>/mean.npy, std.npy  [263] normalisation statistics
 //! <dir>/model.safetensors  denoiser weights
 //! ```
+//!
+//! A sentence-encoder model names its encoder's weights id in the manifest; the encoder is
+//! found in `<dir>/text-encoder`, `<dir>/../text-encoder` or the source tree's
+//! `models/text-encoder`, and one with other weights is refused.
 
-use super::config::ModelConfig;
+use super::config::{ModelConfig, TextEncoderKind};
 use super::denoiser::Mdm;
+use super::prompt::{PromptEncoder, SentencePrompts};
+use super::sentence::{CaptionIndex, SentenceEncoder, default_encoder_dir};
 use super::text::Vocabulary;
 use crate::dataset::store::{read_f32_npy, write_f32_npy};
 use crate::fsutil::write_bytes_atomic;
@@ -35,6 +43,9 @@ pub struct Manifest {
     pub train_seconds: f64,
     /// Whether the SafeTensors file holds f16 values.
     pub half_precision: bool,
+    /// Weights id of the sentence encoder the model was trained with (sentence models).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub text_encoder_id: Option<String>,
 }
 
 /// Errors while loading or saving a bundle.
@@ -71,8 +82,8 @@ pub enum WeightsError {
 pub struct ModelBundle {
     /// Denoiser shape.
     pub config: ModelConfig,
-    /// Text vocabulary.
-    pub vocab: Vocabulary,
+    /// What turns prompts into the denoiser's text condition.
+    pub text: PromptEncoder,
     /// `[263]` feature mean.
     pub mean: Vec<f32>,
     /// `[263]` feature std.
@@ -176,9 +187,11 @@ impl ModelBundle {
         config
             .check()
             .map_err(|e| mismatch(&config_path, format!("bad model config: {e}")))?;
-        let vocab_path = dir.join("vocab.json");
-        let vocab: Vocabulary = serde_json::from_str(&read_text(&vocab_path)?)
-            .map_err(|e| mismatch(&vocab_path, format!("bad vocabulary: {e}")))?;
+        let text = load_prompt_encoder(dir, &config, &manifest, device)?;
+        let vocab_size = match &text {
+            PromptEncoder::Words(vocab) => vocab.len(),
+            PromptEncoder::Sentences(_) => 0,
+        };
         let stat = |name: &str| -> Result<Vec<f32>, WeightsError> {
             let p = dir.join(name);
             let (_, v) = read_f32_npy(&p, &[]).map_err(|e| mismatch(&p, e.to_string()))?;
@@ -201,12 +214,12 @@ impl ModelBundle {
             path: weights_path.clone(),
             reason: e.to_string(),
         })?;
-        let fresh = Mdm::new(&config, vocab.len(), device);
+        let fresh = Mdm::new(&config, vocab_size, device);
         let model = model_from_safetensors(fresh, bytes, manifest.half_precision)
             .map_err(|reason| mismatch(&weights_path, reason))?;
         Ok(ModelBundle {
             config,
-            vocab,
+            text,
             mean,
             std,
             model,
@@ -220,7 +233,7 @@ impl ModelBundle {
         save_bundle_parts(
             dir,
             &self.config,
-            &self.vocab,
+            &self.text,
             &self.mean,
             &self.std,
             &self.manifest,
@@ -236,7 +249,7 @@ impl ModelBundle {
 pub fn save_bundle_parts(
     dir: &Path,
     config: &ModelConfig,
-    vocab: &Vocabulary,
+    text: &PromptEncoder,
     mean: &[f32],
     std: &[f32],
     manifest: &Manifest,
@@ -253,15 +266,128 @@ pub fn save_bundle_parts(
         "config.toml",
         toml::to_string(config).expect("config serialises"),
     )?;
-    put(
-        "vocab.json",
-        serde_json::to_string_pretty(vocab).expect("vocab serialises"),
-    )?;
+    match text {
+        PromptEncoder::Words(vocab) => put(
+            "vocab.json",
+            serde_json::to_string_pretty(vocab).expect("vocab serialises"),
+        )?,
+        PromptEncoder::Sentences(s) => {
+            let p = dir.join("captions.safetensors");
+            s.captions.save(&p).map_err(|e| write_err(&p, e))?;
+        }
+    }
     for (name, v) in [("mean.npy", mean), ("std.npy", std)] {
         let p = dir.join(name);
         write_f32_npy(&p, &[v.len() as u64], v).map_err(|e| write_err(&p, e))?;
     }
     Ok(())
+}
+
+/// The text side of a bundle: its vocabulary, or its caption index and the sentence
+/// encoder it was trained with.
+fn load_prompt_encoder(
+    dir: &Path,
+    config: &ModelConfig,
+    manifest: &Manifest,
+    device: &Device,
+) -> Result<PromptEncoder, WeightsError> {
+    if config.text_encoder == TextEncoderKind::BagOfWords {
+        let vocab_path = dir.join("vocab.json");
+        let vocab: Vocabulary = serde_json::from_str(&read_text(&vocab_path)?)
+            .map_err(|e| mismatch(&vocab_path, format!("bad vocabulary: {e}")))?;
+        return Ok(PromptEncoder::Words(vocab));
+    }
+    let manifest_path = dir.join("manifest.json");
+    let Some(want) = &manifest.text_encoder_id else {
+        return Err(mismatch(
+            &manifest_path,
+            "a sentence-encoder model must name its encoder's `text_encoder_id`",
+        ));
+    };
+    let enc_dir = text_encoder_dir(dir);
+    let encoder =
+        SentenceEncoder::load(&enc_dir, device).map_err(|e| mismatch(&enc_dir, e.to_string()))?;
+    if encoder.id() != want {
+        return Err(mismatch(
+            &enc_dir,
+            format!(
+                "sentence encoder {} but the model was trained with {want}",
+                encoder.id()
+            ),
+        ));
+    }
+    let config_path = dir.join("config.toml");
+    if encoder.dim() != config.d_text {
+        return Err(mismatch(
+            &config_path,
+            format!(
+                "`d_text` is {} but the sentence encoder gives {}-d vectors",
+                config.d_text,
+                encoder.dim()
+            ),
+        ));
+    }
+    let captions_path = dir.join("captions.safetensors");
+    let captions = CaptionIndex::load(&captions_path, device)
+        .map_err(|e| mismatch(&captions_path, e.to_string()))?;
+    Ok(PromptEncoder::Sentences(SentencePrompts {
+        encoder: std::sync::Arc::new(encoder),
+        captions,
+    }))
+}
+
+/// The sentence encoder folder for a bundle: `<dir>/text-encoder`, `<dir>/../text-encoder`,
+/// else the source tree's `models/text-encoder`.
+pub fn text_encoder_dir(bundle: &Path) -> PathBuf {
+    let has = |d: &Path| d.join("encoder.safetensors").exists();
+    let own = bundle.join("text-encoder");
+    if has(&own) {
+        return own;
+    }
+    if let Some(parent) = bundle.parent() {
+        let sibling = parent.join("text-encoder");
+        if has(&sibling) {
+            return sibling;
+        }
+    }
+    default_encoder_dir()
+}
+
+/// One action of a model's training data: a caption and how many training clips (mirrored
+/// copies not counted) carry it as their first caption.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrainedAction {
+    /// The caption ("a person squats down and stands back up").
+    pub caption: String,
+    /// Training clips showing it.
+    pub clips: usize,
+}
+
+/// The actions listed in `<dir>/actions.json`, most clips first; empty when the bundle has
+/// no such file (bundles trained before it existed).
+pub fn trained_actions(dir: &Path) -> Result<Vec<TrainedAction>, WeightsError> {
+    let p = dir.join("actions.json");
+    if !p.exists() {
+        return Ok(Vec::new());
+    }
+    serde_json::from_str(&read_text(&p)?).map_err(|e| mismatch(&p, format!("bad action list: {e}")))
+}
+
+/// The shipped model's training actions as (caption, clips), for the prompt card; empty
+/// when its bundle has no list or cannot be read (the card then goes without).
+pub fn shipped_actions() -> Vec<(String, usize)> {
+    trained_actions(&default_model_dir())
+        .unwrap_or_default()
+        .into_iter()
+        .map(|a| (a.caption, a.clips))
+        .collect()
+}
+
+/// Writes `<dir>/actions.json`.
+pub fn save_trained_actions(dir: &Path, actions: &[TrainedAction]) -> Result<(), WeightsError> {
+    let p = dir.join("actions.json");
+    let text = serde_json::to_string_pretty(actions).expect("actions serialise");
+    write_bytes_atomic(&p, text.as_bytes()).map_err(|e| write_err(&p, e))
 }
 
 /// Where the shipped model lives: `$MPROG_MODEL`, else `models/default` under the current

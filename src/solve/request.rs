@@ -2,18 +2,18 @@
 //! ([`Prior`]), what comes back ([`SolveResult`]) and progress reports ([`Progress`]).
 
 use super::solver::Solver;
-use crate::model::text::Vocabulary;
+use crate::model::prompt::PromptEncoder;
 use crate::model::{Mdm, ModelBundle};
 use crate::motion::Motion;
 use crate::scene::Placement;
 
-/// The motion prior the solvers steer: denoiser, vocabulary and normalisation statistics.
+/// The motion prior the solvers steer: denoiser, prompt encoder and normalisation statistics.
 #[derive(Clone, Copy, Debug)]
 pub struct Prior<'a> {
     /// The denoiser (any mode; solvers make their own inference or frozen copies).
     pub model: &'a Mdm,
-    /// Its text vocabulary.
-    pub vocab: &'a Vocabulary,
+    /// What turns its prompts into the text condition.
+    pub text: &'a PromptEncoder,
     /// `[263]` feature mean.
     pub mean: &'a [f32],
     /// `[263]` feature std.
@@ -27,7 +27,7 @@ impl<'a> Prior<'a> {
     pub fn from_bundle(bundle: &'a ModelBundle) -> Self {
         Prior {
             model: &bundle.model,
-            vocab: &bundle.vocab,
+            text: &bundle.text,
             mean: &bundle.mean,
             std: &bundle.std,
             max_frames: bundle.config.max_frames,

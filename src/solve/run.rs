@@ -72,10 +72,10 @@ impl Ctx<'_> {
         [self.motions(), self.frames, FEATURE_DIM]
     }
 
-    /// The tokenised prompts (CFG-doubled) on `device`.
+    /// The encoded prompts (CFG-doubled) on `device`.
     pub fn condition(&self, device: &Device) -> Condition {
         let p: Vec<&str> = self.prompts.iter().map(String::as_str).collect();
-        Condition::new(self.prior.vocab, &p, self.guidance_scale, device)
+        Condition::new(self.prior.text, &p, self.guidance_scale, device)
     }
 
     /// Host values of the initial noise x_T.
@@ -289,7 +289,7 @@ fn finish(
     let p: Vec<&str> = req.prompts.iter().map(String::as_str).collect();
     let unknown_words = p
         .iter()
-        .map(|text| ctx.prior.vocab.tokenize(text).1)
+        .map(|text| ctx.prior.text.unknown_words(text))
         .collect();
     Ok(SolveResult {
         motions,

@@ -9,6 +9,7 @@ use crate::features::layout::RIC;
 use crate::model::config::ModelConfig;
 use crate::model::generate::{GenerateRequest, generate};
 use crate::model::noise::NoiseSource;
+use crate::model::prompt::PromptEncoder;
 use crate::model::sampler::SamplerKind;
 use crate::model::text::Vocabulary;
 use crate::model::weights::Manifest;
@@ -61,6 +62,7 @@ pub(super) fn tiny_bundle() -> ModelBundle {
         d_ff: 64,
         dropout: 0.1,
         d_text: 8,
+        text_encoder: Default::default(),
         max_frames: 40,
         input_skip: false,
     };
@@ -82,7 +84,7 @@ pub(super) fn tiny_bundle() -> ModelBundle {
     }
     ModelBundle {
         config,
-        vocab,
+        text: PromptEncoder::Words(vocab),
         mean,
         std,
         model,

@@ -45,6 +45,11 @@ impl CaptionIndex {
         }
     }
 
+    /// `[N, dim]` unit vectors, one row per caption in [`Self::captions`]' order.
+    pub fn embeddings(&self) -> &Tensor<2> {
+        &self.embeddings
+    }
+
     /// The captions, sorted.
     pub fn captions(&self) -> &[String] {
         &self.captions

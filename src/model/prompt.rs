@@ -1,0 +1,213 @@
+//! What a prompt becomes for the denoiser, for either text encoder: token ids for a
+//! bag-of-words model, sentence vectors for a model conditioned on the frozen sentence
+//! encoder. [`PromptEncoder`] is the bundle's side (prompts → [`TextBatch`], and what to
+//! tell the user about a prompt); [`TextBatch`] is what travels in a `DenoiserInput`.
+
+use super::sentence::{CaptionIndex, FAR_COSINE, Nearest, SentenceEncoder};
+use super::text::{TokenBatch, Vocabulary};
+use burn::prelude::*;
+use std::sync::Arc;
+
+/// Words that name a side; the mirrored question swaps them.
+pub const SIDE_WORDS: [(&str, &str); 2] = [("left", "right"), ("clockwise", "counterclockwise")];
+
+/// A prompt with its side words swapped ("turns left" → "turns right"), as the training
+/// data's mirrored copies are captioned.
+pub fn swap_side_words(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut word = String::new();
+    let flush = |word: &mut String, out: &mut String| {
+        let lower = word.to_lowercase();
+        let swapped = SIDE_WORDS
+            .iter()
+            .find_map(|&(a, b)| (lower == a).then_some(b).or((lower == b).then_some(a)));
+        out.push_str(swapped.unwrap_or(word));
+        word.clear();
+    };
+    for c in text.chars() {
+        if c.is_alphanumeric() {
+            word.push(c);
+        } else {
+            flush(&mut word, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut word, &mut out);
+    out
+}
+
+/// Sentence vectors of a batch of prompts and of their side-swapped versions.
+#[derive(Clone, Debug)]
+pub struct SentenceBatch {
+    /// `[B, D]` unit vectors.
+    pub vectors: Tensor<2>,
+    /// `[B, D]` vectors of the prompts with left and right swapped (for mirror averaging).
+    pub mirrored: Tensor<2>,
+}
+
+/// The text condition of a batch, in the form the model's encoder reads.
+#[derive(Clone, Debug)]
+pub enum TextBatch {
+    /// Token ids for a bag-of-words model.
+    Words(TokenBatch),
+    /// Sentence vectors for a sentence-encoder model.
+    Sentences(SentenceBatch),
+}
+
+impl TextBatch {
+    /// This batch followed by itself (the unconditional half of classifier-free guidance).
+    pub fn doubled(&self) -> TextBatch {
+        self.clone().concat(self.clone())
+    }
+
+    /// `self` then `other`, along the batch.
+    pub fn concat(self, other: TextBatch) -> TextBatch {
+        match (self, other) {
+            (TextBatch::Words(a), TextBatch::Words(b)) => {
+                let len = pad_width(a.ids.dims()[1], b.ids.dims()[1]);
+                TextBatch::Words(TokenBatch {
+                    ids: Tensor::cat(vec![pad_ids(a.ids, len), pad_ids(b.ids, len)], 0),
+                    mask: Tensor::cat(vec![pad_mask(a.mask, len), pad_mask(b.mask, len)], 0),
+                    unknown: [a.unknown, b.unknown].concat(),
+                })
+            }
+            (TextBatch::Sentences(a), TextBatch::Sentences(b)) => {
+                TextBatch::Sentences(SentenceBatch {
+                    vectors: Tensor::cat(vec![a.vectors, b.vectors], 0),
+                    mirrored: Tensor::cat(vec![a.mirrored, b.mirrored], 0),
+                })
+            }
+            _ => unreachable!("one prompt encoder builds every text batch of a run"),
+        }
+    }
+}
+
+/// Widths padded to the longer of two `[B, L]` token batches, with PAD ids and mask 0.
+fn pad_width(a: usize, b: usize) -> usize {
+    a.max(b)
+}
+
+fn pad_ids(t: Tensor<2, Int>, len: usize) -> Tensor<2, Int> {
+    let [rows, l] = t.dims();
+    if l == len {
+        return t;
+    }
+    let zeros = Tensor::<2, Int>::zeros([rows, len - l], &t.device());
+    Tensor::cat(vec![t, zeros], 1)
+}
+
+fn pad_mask(t: Tensor<2>, len: usize) -> Tensor<2> {
+    let [rows, l] = t.dims();
+    if l == len {
+        return t;
+    }
+    let zeros = Tensor::<2>::zeros([rows, len - l], &t.device());
+    Tensor::cat(vec![t, zeros], 1)
+}
+
+/// The sentence encoder with the captions a model was trained on.
+#[derive(Clone, Debug)]
+pub struct SentencePrompts {
+    /// The frozen encoder.
+    pub encoder: Arc<SentenceEncoder>,
+    /// The training captions, embedded (for "nearest known caption").
+    pub captions: CaptionIndex,
+}
+
+/// Turns prompts into a model's text condition.
+#[derive(Clone, Debug)]
+pub enum PromptEncoder {
+    /// A bag-of-words model's vocabulary.
+    Words(Vocabulary),
+    /// A sentence-encoder model's encoder and training captions.
+    Sentences(SentencePrompts),
+}
+
+impl PromptEncoder {
+    /// The text condition of `prompts`, one per sample.
+    pub fn batch(&self, prompts: &[&str], device: &Device) -> TextBatch {
+        match self {
+            PromptEncoder::Words(vocab) => {
+                TextBatch::Words(TokenBatch::new(vocab, prompts, device))
+            }
+            PromptEncoder::Sentences(s) => {
+                let b = prompts.len();
+                let swapped: Vec<String> = prompts.iter().map(|p| swap_side_words(p)).collect();
+                let mut all: Vec<&str> = prompts.to_vec();
+                all.extend(swapped.iter().map(String::as_str));
+                let both = s.encoder.encode(&all).to_device(device);
+                TextBatch::Sentences(SentenceBatch {
+                    vectors: both.clone().narrow(0, 0, b),
+                    mirrored: both.narrow(0, b, b),
+                })
+            }
+        }
+    }
+
+    /// Words of `prompt` the model cannot read (always none for a sentence encoder).
+    pub fn unknown_words(&self, prompt: &str) -> Vec<String> {
+        match self {
+            PromptEncoder::Words(vocab) => vocab.tokenize(prompt).1,
+            PromptEncoder::Sentences(_) => Vec::new(),
+        }
+    }
+
+    /// The training caption nearest to `prompt` (None for a bag-of-words model).
+    pub fn nearest_caption(&self, prompt: &str) -> Option<Nearest> {
+        match self {
+            PromptEncoder::Words(_) => None,
+            PromptEncoder::Sentences(s) => s.captions.nearest(&s.encoder, &[prompt]).pop(),
+        }
+    }
+
+    /// What the model makes of a prompt, as lines for the user: for a bag-of-words model
+    /// the words read as a known inflection and the words ignored; for a sentence-encoder
+    /// model a warning when the prompt lies far from every training caption, with the
+    /// nearest one. Empty when there is nothing to say.
+    pub fn report(&self, prompt: &str) -> Vec<String> {
+        match self {
+            PromptEncoder::Words(vocab) => vocab.word_report(prompt),
+            PromptEncoder::Sentences(_) => match self.nearest_caption(prompt) {
+                Some(n) if n.cosine < FAR_COSINE => vec![far_prompt_line(&n)],
+                _ => Vec::new(),
+            },
+        }
+    }
+}
+
+/// The user-facing line for a prompt far from every training caption.
+pub fn far_prompt_line(n: &Nearest) -> String {
+    format!(
+        "the prompt is far from every caption the model was trained on (cosine {:.2} < {FAR_COSINE}); nearest known: \"{}\"",
+        n.cosine, n.caption
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn side_words_swap_as_whole_words() {
+        assert_eq!(
+            swap_side_words("A person turns Left, then right; upright"),
+            "A person turns right, then left; upright"
+        );
+        assert_eq!(swap_side_words("walks clockwise"), "walks counterclockwise");
+        assert_eq!(swap_side_words(""), "");
+    }
+
+    #[test]
+    fn word_batches_of_different_lengths_concatenate() {
+        let dev = Device::flex();
+        let v = Vocabulary::from_captions(["walk run jump"], 8);
+        let a = TextBatch::Words(TokenBatch::new(&v, &["walk"], &dev));
+        let b = TextBatch::Words(TokenBatch::new(&v, &["walk run jump"], &dev));
+        let TextBatch::Words(t) = a.concat(b) else {
+            panic!("words stay words")
+        };
+        assert_eq!(t.ids.dims(), [2, 3]);
+        let mask = t.mask.into_data().try_into_vec::<f32>().unwrap();
+        assert_eq!(mask, vec![1.0, 0.0, 0.0, 1.0, 1.0, 1.0]);
+    }
+}

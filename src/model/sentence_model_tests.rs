@@ -1,0 +1,149 @@
+//! A denoiser conditioned on the frozen sentence encoder: a run started from a
+//! bag-of-words bundle keeps every other weight, its bundle names the encoder and is
+//! refused with another one, and the bundle tells when a prompt is far from its captions.
+
+use super::config::{ModelConfig, TextEncoderKind, TrainConfig};
+use super::denoiser::Mdm;
+use super::prompt::PromptEncoder;
+use super::sentence::{SentenceEncoder, default_encoder_dir};
+use super::tests::{synthetic_dataset, tiny};
+use super::train::TrainRun;
+use super::weights::ModelBundle;
+use burn::prelude::*;
+use burn::store::ModuleSnapshot;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+fn sentence_tiny() -> ModelConfig {
+    ModelConfig {
+        d_text: 384,
+        text_encoder: TextEncoderKind::Sentence,
+        ..tiny()
+    }
+}
+
+fn tensors(m: &Mdm) -> BTreeMap<String, Vec<f32>> {
+    m.collect(None, None, false)
+        .iter()
+        .map(|t| {
+            let data = burn::store::bridge::to_data(t).unwrap();
+            (t.name.clone(), data.try_to_vec::<f32>().unwrap())
+        })
+        .collect()
+}
+
+fn train(out: &Path, model: ModelConfig, init: Option<&Path>, lr: f64, steps: usize) {
+    let data = synthetic_dataset();
+    TrainRun {
+        data: &data,
+        config: TrainConfig {
+            model,
+            batch_size: 2,
+            crop_frames: 8,
+            learning_rate: lr,
+            warmup_steps: 1,
+            checkpoint_every: 5,
+            steps: 100,
+            ..TrainConfig::default()
+        },
+        out: out.to_path_buf(),
+        max_steps_now: Some(steps),
+        interrupt: Default::default(),
+        init_from: init.map(Path::to_path_buf),
+        device: Device::flex(),
+        after_checkpoint: None,
+        text_encoder: None,
+    }
+    .run(&|_, _, _| {})
+    .unwrap();
+}
+
+#[test]
+fn a_bag_of_words_bundle_starts_a_sentence_run_with_its_other_weights() {
+    let dev = Device::flex();
+    let bag_dir = tempfile::tempdir().unwrap();
+    train(bag_dir.path(), tiny(), None, 1e-3, 5);
+    let bag = ModelBundle::load(&bag_dir.path().join("bundle"), &dev).unwrap();
+    // A learning rate of ~0 keeps the carried weights where they were.
+    let run_dir = tempfile::tempdir().unwrap();
+    let init = bag_dir.path().join("bundle");
+    train(run_dir.path(), sentence_tiny(), Some(&init), 1e-12, 5);
+    let bundle_dir = run_dir.path().join("bundle");
+    let sentence = ModelBundle::load(&bundle_dir, &dev).unwrap();
+    assert_eq!(sentence.manifest.steps, 10, "the bundle's steps carry on");
+    let encoder = SentenceEncoder::load(&default_encoder_dir(), &dev).unwrap();
+    assert_eq!(
+        sentence.manifest.text_encoder_id.as_deref(),
+        Some(encoder.id())
+    );
+    let PromptEncoder::Sentences(s) = &sentence.text else {
+        panic!("a sentence-encoder bundle reads prompts with the sentence encoder")
+    };
+    assert_eq!(
+        s.captions.captions(),
+        ["a person walks forward", "a person waves"]
+    );
+    let (old, new) = (tensors(&bag.model), tensors(&sentence.model));
+    let mut carried = 0;
+    for (name, value) in &new {
+        if name.starts_with("text") {
+            continue;
+        }
+        let before = &old[name];
+        let diff = before
+            .iter()
+            .zip(value)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        // f16 bundles: one rounding step of the largest weights.
+        assert!(diff < 2e-3, "{name} moved by {diff}");
+        carried += 1;
+    }
+    assert!(carried > 10, "{carried} tensors compared");
+    assert!(!new.keys().any(|k| k.starts_with("text.")), "no word table");
+    assert_eq!(new["text_proj.weight"].len(), 384 * tiny().d_model);
+}
+
+#[test]
+fn a_sentence_bundle_is_refused_with_another_encoder() {
+    let dev = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    train(dir.path(), sentence_tiny(), None, 1e-3, 5);
+    let bundle = dir.path().join("bundle");
+    ModelBundle::load(&bundle, &dev).unwrap();
+    let manifest = bundle.join("manifest.json");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    let id = ModelBundle::load(&bundle, &dev)
+        .unwrap()
+        .manifest
+        .text_encoder_id
+        .unwrap();
+    std::fs::write(&manifest, text.replace(&id, "minilm-l6-0000000000000000")).unwrap();
+    let err = ModelBundle::load(&bundle, &dev).unwrap_err().to_string();
+    assert!(
+        err.contains("text-encoder") && err.contains("trained with minilm-l6-0000000000000000"),
+        "{err}"
+    );
+    std::fs::write(
+        &manifest,
+        text.replace(&format!("\"text_encoder_id\": \"{id}\""), "\"x\": 1"),
+    )
+    .unwrap();
+    let err = ModelBundle::load(&bundle, &dev).unwrap_err().to_string();
+    assert!(err.contains("text_encoder_id"), "{err}");
+}
+
+#[test]
+fn far_prompts_are_reported_with_the_nearest_caption() {
+    let dev = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    train(dir.path(), sentence_tiny(), None, 1e-3, 5);
+    let bundle = ModelBundle::load(&dir.path().join("bundle"), &dev).unwrap();
+    assert!(bundle.text.report("someone strolls ahead").is_empty());
+    let far = bundle
+        .text
+        .report("the committee approved the annual budget");
+    assert_eq!(far.len(), 1, "{far:?}");
+    assert!(far[0].contains("nearest known: \"a person"), "{far:?}");
+    assert!(bundle.text.unknown_words("someone moonwalks").is_empty());
+}

@@ -1,0 +1,225 @@
+//! The loss of one training batch: masked x0 MSE plus MDM's geometric terms (foot
+//! contact, velocity) and the extra root-column MSE.
+
+use super::text::TrainText;
+use crate::dataset::FEATURE_DIM;
+use crate::features::layout::{CONTACT, RIC, ROOT_Y, ROOT_YAW_VEL};
+use crate::features::recover_from_ric_tensor;
+use crate::model::batch::HostBatch;
+use crate::model::config::TrainConfig;
+use crate::model::denoiser::{Denoiser, DenoiserInput, Mdm};
+use crate::model::noise::NoiseSource;
+use crate::model::schedule::NoiseSchedule;
+use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT};
+use burn::prelude::*;
+
+/// A batch moved to tensors.
+fn to_device(
+    batch: &HostBatch,
+    text: &TrainText,
+    device: &Device,
+) -> (DenoiserInput, Tensor<3>, Tensor<3>) {
+    let b = batch.captions.len();
+    let n = batch.frames;
+    let x0: Tensor<3> = Tensor::from_data(
+        TensorData::new(batch.x0.clone(), [b, n, FEATURE_DIM]),
+        device,
+    );
+    let valid: Vec<f32> = batch
+        .padding
+        .iter()
+        .map(|&p| if p { 0.0 } else { 1.0 })
+        .collect();
+    let valid: Tensor<3> = Tensor::from_data(TensorData::new(valid, [b, n, 1]), device);
+    let captions: Vec<&str> = batch.captions.iter().map(String::as_str).collect();
+    let input = DenoiserInput {
+        x_t: x0.clone(),
+        timesteps: batch.timesteps.clone(),
+        text: text.batch(&captions, device),
+        keep_text: Tensor::from_data(TensorData::new(batch.keep_text.clone(), [b]), device),
+        padding: Some(Tensor::from_data(
+            TensorData::new(batch.padding.clone(), [b, n]),
+            device,
+        )),
+    };
+    (input, x0, valid)
+}
+
+/// Noises x0 to each sample's timestep: x_t = √ᾱ x0 + √(1−ᾱ) ε.
+fn q_sample(schedule: &NoiseSchedule, x0: Tensor<3>, timesteps: &[usize], seed: u64) -> Tensor<3> {
+    let device = x0.device();
+    let dims = x0.dims();
+    let (a, s): (Vec<f32>, Vec<f32>) = timesteps
+        .iter()
+        .map(|&t| {
+            let ab = schedule.alphas_cumprod[t];
+            (ab.sqrt() as f32, (1.0 - ab).sqrt() as f32)
+        })
+        .unzip();
+    let b = timesteps.len();
+    let a: Tensor<3> = Tensor::from_data(TensorData::new(a, [b, 1, 1]), &device);
+    let s: Tensor<3> = Tensor::from_data(TensorData::new(s, [b, 1, 1]), &device);
+    let eps = NoiseSource::new(seed).tensor(dims, &device);
+    x0 * a + eps * s
+}
+
+/// Masked x0 MSE: Σ over valid frames and features / (#valid frames · F).
+pub fn masked_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+    let f = pred.dims()[2] as f32;
+    let err = (pred - x0).powi_scalar(2) * valid.clone();
+    err.sum() / (valid.sum() * f)
+}
+
+/// Masked x0 MSE of the root columns alone (yaw velocity, XZ velocity, height).
+pub fn root_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+    let root = ROOT_YAW_VEL.start..ROOT_Y.end;
+    let cols = |t: Tensor<3>| t.narrow(2, root.start, root.len());
+    masked_mse(cols(pred), cols(x0), valid)
+}
+
+/// Foot-contact loss (MDM's L_foot): the squared per-frame displacement, in cm², of each
+/// foot joint (ankles and toes) of the predicted motion on the frame pairs where the
+/// data's contact label says that joint is planted, averaged over those pairs.
+pub struct FootLoss {
+    /// Weight of the term in the training loss.
+    pub weight: f32,
+    /// `[1, 1, 263]` feature mean, to de-normalise predictions.
+    pub mean: Tensor<3>,
+    /// `[1, 1, 263]` feature std.
+    pub std: Tensor<3>,
+}
+
+impl FootLoss {
+    /// The loss for a dataset's statistics, or None when `weight` is 0.
+    pub fn new(weight: f64, mean: &[f32], std: &[f32], device: &Device) -> Option<Self> {
+        let stat =
+            |v: &[f32]| Tensor::from_data(TensorData::new(v.to_vec(), [1, 1, v.len()]), device);
+        (weight > 0.0).then(|| FootLoss {
+            weight: weight as f32,
+            mean: stat(mean),
+            std: stat(std),
+        })
+    }
+
+    /// The term for normalised prediction and target `[B, N, 263]`, `valid` `[B, N, 1]`.
+    pub fn term(&self, pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+        let [b, n, _] = pred.dims();
+        if n < 2 {
+            return Tensor::zeros([1], &pred.device());
+        }
+        let device = pred.device();
+        let joints = recover_from_ric_tensor(pred * self.std.clone() + self.mean.clone());
+        let feet: Vec<i64> = FOOT_LEFT
+            .iter()
+            .chain(FOOT_RIGHT.iter())
+            .map(|&j| j as i64)
+            .collect();
+        let feet = joints.select(2, Tensor::from_data(TensorData::new(feet, [4]), &device)); // [B, N, 4, 3]
+        let step = (feet.clone().narrow(1, 1, n - 1) - feet.narrow(1, 0, n - 1)).mul_scalar(100.0);
+        let slide = step.powi_scalar(2).sum_dim(3).reshape([b, n - 1, 4]);
+        let c = CONTACT.start;
+        let label = x0.narrow(2, c, 4) * self.std.clone().narrow(2, c, 4)
+            + self.mean.clone().narrow(2, c, 4);
+        let both_valid = valid.clone().narrow(1, 0, n - 1) * valid.narrow(1, 1, n - 1);
+        let planted = label.narrow(1, 0, n - 1).greater_elem(0.5).float() * both_valid;
+        (slide * planted.clone()).sum() / (planted.sum() + 1.0)
+    }
+}
+
+/// Velocity loss (MDM's L_vel) on the joint positions the features store (root height and
+/// the 21 root-relative joints): the squared error, in cm² per joint, of the predicted
+/// per-frame displacement against the data's, averaged over valid frame pairs. The x0 MSE
+/// treats every frame alone, so an undertrained model's errors are independent from frame
+/// to frame and show as jitter; this term penalises exactly that high-frequency part.
+pub struct VelocityLoss {
+    /// Weight of the term in the training loss.
+    pub weight: f32,
+    /// `[1, 1, 64]` feature std of the position block, to de-normalise the error (the
+    /// mean cancels in a difference).
+    pub std: Tensor<3>,
+}
+
+/// The feature columns the velocity loss reads: root height then the 21 joints' x, y, z.
+const POSITION_COLUMNS: std::ops::Range<usize> = ROOT_Y.start..RIC.end;
+
+impl VelocityLoss {
+    /// The loss for a dataset's statistics, or None when `weight` is 0.
+    pub fn new(weight: f64, std: &[f32], device: &Device) -> Option<Self> {
+        let cols = std[POSITION_COLUMNS].to_vec();
+        let len = cols.len();
+        (weight > 0.0).then(|| VelocityLoss {
+            weight: weight as f32,
+            std: Tensor::from_data(TensorData::new(cols, [1, 1, len]), device),
+        })
+    }
+
+    /// The term for normalised prediction and target `[B, N, 263]`, `valid` `[B, N, 1]`.
+    pub fn term(&self, pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+        let n = pred.dims()[1];
+        if n < 2 {
+            return Tensor::zeros([1], &pred.device());
+        }
+        let cols = POSITION_COLUMNS;
+        let err = (pred.narrow(2, cols.start, cols.len()) - x0.narrow(2, cols.start, cols.len()))
+            * self.std.clone()
+            * 100.0;
+        let step = err.clone().narrow(1, 1, n - 1) - err.narrow(1, 0, n - 1);
+        let both_valid = valid.clone().narrow(1, 0, n - 1) * valid.narrow(1, 1, n - 1);
+        // Sum over the columns / 3 = squared displacement error per joint (root height
+        // counts as a third of a joint).
+        let per_pair =
+            step.powi_scalar(2).sum_dim(2) * both_valid.clone() / (cols.len() as f32 / 3.0);
+        per_pair.sum() / (both_valid.sum() + 1.0)
+    }
+}
+
+/// The geometric terms added to the x0 MSE in training (each None when its weight is 0).
+#[derive(Default)]
+pub struct GeometricLosses {
+    /// MDM's foot-contact term.
+    pub foot: Option<FootLoss>,
+    /// MDM's velocity term.
+    pub velocity: Option<VelocityLoss>,
+    /// Weight of the extra root-column MSE (None when 0).
+    pub root: Option<f32>,
+}
+
+impl GeometricLosses {
+    /// The terms a training config asks for, with the dataset's statistics.
+    pub fn new(cfg: &TrainConfig, mean: &[f32], std: &[f32], device: &Device) -> Self {
+        GeometricLosses {
+            foot: FootLoss::new(cfg.foot_loss, mean, std, device),
+            velocity: VelocityLoss::new(cfg.velocity_loss, std, device),
+            root: (cfg.root_loss > 0.0).then_some(cfg.root_loss as f32),
+        }
+    }
+}
+
+/// Loss of one batch: the x0 MSE plus the geometric terms that are on.
+pub(super) fn batch_loss(
+    model: &Mdm,
+    schedule: &NoiseSchedule,
+    batch: &HostBatch,
+    text: &TrainText,
+    geometric: &GeometricLosses,
+    device: &Device,
+) -> Tensor<1> {
+    let (mut input, x0, valid) = to_device(batch, text, device);
+    input.x_t = q_sample(schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
+    let pred = model.predict_x0(&input);
+    let mut loss = masked_mse(pred.clone(), x0.clone(), valid.clone());
+    if let Some(f) = &geometric.foot {
+        loss = loss
+            + f.term(pred.clone(), x0.clone(), valid.clone())
+                .mul_scalar(f.weight);
+    }
+    if let Some(v) = &geometric.velocity {
+        loss = loss
+            + v.term(pred.clone(), x0.clone(), valid.clone())
+                .mul_scalar(v.weight);
+    }
+    if let Some(w) = geometric.root {
+        loss = loss + root_mse(pred, x0, valid).mul_scalar(w);
+    }
+    loss
+}
