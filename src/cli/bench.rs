@@ -1,7 +1,7 @@
 //! `mprog bench`: timing tables (medians over repeated runs) printed as markdown.
 
 use burn::prelude::*;
-use miette::Result;
+use miette::{IntoDiagnostic, Result, WrapErr};
 use mprog::model::denoiser::{Denoiser, DenoiserInput, Mdm};
 use mprog::model::noise::NoiseSource;
 use mprog::model::prompt::PromptEncoder;
@@ -23,6 +23,35 @@ pub enum BenchCommand {
     /// What steering costs: each solver at the papers' defaults on one program next to its
     /// unguided sampler (time ratios, latent seconds per motion).
     Solvers(super::bench_solvers::SolverBenchArgs),
+    /// What the prior does with named actions: jump, kick, crouch, pick up, lie down, run,
+    /// walk, a paraphrase, hand raises (seeds 1 and 2, one number each, ✗ below threshold).
+    Actions(ActionBenchArgs),
+}
+
+/// Arguments of `mprog bench actions`.
+#[derive(clap::Args)]
+pub struct ActionBenchArgs {
+    /// Model bundle (default: the shipped model).
+    #[arg(long)]
+    model: Option<PathBuf>,
+}
+
+fn bench_actions(args: ActionBenchArgs) -> Result<()> {
+    let device = super::device()?;
+    let dir = args
+        .model
+        .unwrap_or_else(mprog::model::weights::default_model_dir);
+    let bundle = ModelBundle::load(&dir, &device)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot load the model {}", dir.display()))?;
+    let rows = mprog::metrics::actions::measure_actions(&bundle, &device).into_diagnostic()?;
+    println!(
+        "model {} ({}): 6 s, DDIM 50, guidance 2.5, no cleanup; heights above the motion's lowest foot joint\n",
+        bundle.manifest.weights_id,
+        dir.display()
+    );
+    print!("{}", mprog::metrics::actions::actions_table(&rows));
+    Ok(())
 }
 
 /// Arguments of `mprog bench model`.
@@ -46,6 +75,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Model(args) => bench_model(args),
         BenchCommand::Tasks(args) => super::bench_tasks::run(args),
         BenchCommand::Solvers(args) => super::bench_solvers::run(args),
+        BenchCommand::Actions(args) => bench_actions(args),
     }
 }
 

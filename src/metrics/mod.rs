@@ -9,6 +9,7 @@
 //! | evaluator | [`encoder`], [`evaluator`], [`train_encoder`], [`card`] | contrastive motion/caption encoders, their files, their training |
 //! | report | [`report`], [`table`] | generate for test captions, score every set, markdown tables |
 
+pub mod actions;
 pub mod card;
 pub mod encoder;
 pub mod error;

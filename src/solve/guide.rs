@@ -9,103 +9,21 @@
 //!                  μ ← μ − τ·Σ̂·g
 //! x_{t−1} ← μ + σ_t·ε   (no noise at the last step)
 //! ```
-//! In the last T_s steps the inner loop works on the skeleton (mprog's addition, on by
-//! default: [`GuideConfig::keep_skeleton`]): it minimises `E(P(μ))` and writes `P(μ)` back,
-//! where `P` restores the bone lengths and keeps planted feet on the floor
-//! ([`super::bones`]). Without it the 500 late iterations meet a constraint by moving one
-//! joint away from its bones (a head pulled into the chest), which nothing repairs later.
-//!
-//! In the same last T_s steps each iteration steps along the gradient smoothed over time
-//! (mprog's addition, [`GuideConfig::smooth_frames`]): a Gaussian over frames, a
-//! Sobolev-style preconditioner. It is still a descent direction and the Polyak step still
-//! removes the same fraction of the linearised error, but a keyframe moves its neighbours
-//! too, so "head below 0.5 m at frame 60" becomes a dip over about a second instead of a
-//! one-frame spike. Earlier steps keep OmniControl's raw gradient: there the denoiser
-//! answers every edit, and smoothed edits of every frame's pose led it elsewhere (a walk
-//! between two close walls stopped walking).
-//!
-//! Before the last T_s steps only the root columns move (mprog's addition, on by default:
-//! [`GuideConfig::early_root_only`]). OmniControl edits every column of μ from the first
-//! step, and this prior answers edited poses with its data: the training set has no walk
-//! with a hand held up, so a walk whose wrist the guide kept on the head came back as a
-//! standing pose carried along by the walk's root velocity, a statue gliding 11–17 m with
-//! its feet still ("walks with the left hand on the head", HSC-1). Steering only the path
-//! early leaves the gait to the denoiser; the late steps then place the limbs on the
-//! walking body. Errors that depend on the path (reach a point, stay in a square) still
-//! act from the first step. The root moves by the step the whole gradient calls for: sized
-//! from the root's share alone, a pose error with a small root gradient pushed the root
-//! height by metres and the walker stopped.
-//!
-//! In the same last T_s steps planted feet are held (mprog's addition,
-//! [`GuideConfig::foot_lock`], [`super::feet`]): the step also reduces the slide of toes
-//! that are on the floor, so a constraint met by moving the root moves the legs with it.
-//! On the walking programs it halves the skating of the result at the same program error.
-//!
-//! In the last T_s steps each statement of a program gets its own Polyak step (mprog's
-//! addition, on by default: [`GuideConfig::split_terms`]) and the iteration steps along
-//! their sum: each one removes its share of its own linearised error, whatever the others'
-//! gradients. Earlier steps, which move only the path, keep one step for the whole error:
-//! split there, statements that conflict over the path pulled it each their own way
-//! (HSI-4 met "duck under the barrier" by stopping before it, 0.76 m short of its end
-//! target). With one step
-//! for the whole error, a stiff statement sets the pace: `faceToFace` at two frames has a
-//! large gradient (a kink at zero, hip vectors 0.2 m long) and a small value, so the step
-//! sized on the sum hardly moved the handshake's contact (0.29 m off after the last step,
-//! the facing term bouncing across its kink); stepped apart, both are met (0.01 m). The
-//! foot lock's penalty is shared out among the statements in proportion to their errors
-//! ([`TermGradients::share_penalty`](super::host::TermGradients::share_penalty)): as a
-//! term with a step of its own it held the feet so firmly that the hands could not meet.
-//! A single-statement program steps exactly as before.
-//!
-//! The late steps are preconditioned ([`GuideConfig::late_root_scale`], `late_root`,
-//! 0.01 by default): the root columns of each step direction are scaled down. Moving the
-//! root moves every joint of every later frame, so the root's gradient dwarfs the pose's
-//! and the step goes to the path: two people asked to hold hands were walked into each
-//! other (pelvises 0.47 m apart against 0.75 m asked) with their wrists at 0.87 m on every
-//! frame, 0.53 m off. Scaled, the late steps lift and bend the arms instead. The early
-//! steps, which steer the path, are not scaled, so a target only the path can reach is
-//! still met (the late steps keep 1 % of the root's share for the last centimetres).
-//! With weights step 6,550 it was made the default (it was 1): at `guide`'s defaults, seed
-//! 1, the dance holding hands 0.18 → 0.015 m and the three-person fight 0.10 → 0.002 m;
-//! in the task benchmark's CPU settings the keyframe error 0.031 → 0.006 m and the PMG
-//! tasks' mean 0.028 → 0.020, at max acceleration 0.167 → 0.199.
+//! mprog's additions, each on by default and turned back by its knob (why each was made,
+//! with the renders and numbers behind it: the book's "Six places where `guide` departs
+//! from OmniControl"):
+//! * early steps move only the root columns ([`GuideConfig::early_root_only`], `early_root`);
+//! * the last T_s steps keep bone lengths and planted feet ([`GuideConfig::keep_skeleton`],
+//!   [`super::bones`]), hold planted toes ([`GuideConfig::foot_lock`], [`super::feet`]),
+//!   smooth the step over frames ([`GuideConfig::smooth_frames`]), give each statement its
+//!   own Polyak step ([`GuideConfig::split_terms`]) and scale the root columns down
+//!   ([`GuideConfig::late_root_scale`], `late_root`);
+//! * frame 0 is not frozen ([`GuideConfig::freeze_first_frame`], `freeze`).
 //!
 //! The denoiser is not in the inner loop: only FK, the error and its gradient are, through
-//! the fused host path ([`super::host`]) by default.
-//!
-//! **Where the code and the paper differ, and what is followed here (the code):**
-//! * Σ̂ = max(Σ_t, 0.01), a floor (code); the paper's App. A.2 writes min(Σ_t, 0.01)
-//!   ([`VarianceRule::Cap`] selects it). With the cosine schedule the floor is what acts
-//!   for every t < 807.
-//! * K = 500 on the last 10 steps and 10 before (code and the paper's Eq. 4; the paper's
-//!   prose says the opposite end). With a respaced chain "the last T_s steps" means the
-//!   last T_s steps of that chain (so the total inner-iteration count stays K_e·(n−T_s) +
-//!   K_l·T_s).
-//! * The code zeroes the gradient of every feature of frame 0 (it indexes the frame axis
-//!   while its comment speaks of the root, which `recover_from_ric` pins at the origin
-//!   anyway). **Not followed by default** ([`GuideConfig::freeze_first_frame`], knob
-//!   `freeze=1`): a constraint on the first frame could then never be met (HOI-1's pick
-//!   stayed 0.36 m off) and the late-step smoothing, which spreads that frame's gradient to
-//!   its neighbours, moved frame 1 without frame 0: a 0.87 m jump of the wrist in one frame.
-//!
-//! **Step size that transfers between programs.** OmniControl differentiates
-//! G = Σ_{n,j} ‖p_{n,j} − c_{n,j}‖ (a sum over the V controlled frames of each joint) and
-//! steps by τ·Σ̂ with τ = 20/V, i.e. by 20·Σ̂·∇(Σ_j mean_n ‖p − c‖): twenty times the
-//! gradient of the **per-joint mean distance, summed over controlled joints**. mprog's
-//! error has that form (a sum over statements of each statement's mean over its frames, in
-//! metres), so [`StepRule::Gradient`] steps `μ ← μ − τ·Σ̂·∇E` with τ = 20 and no 1/V: for
-//! one "joint at target on V frames" statement per controlled joint (same density) this is
-//! OmniControl's update exactly. It does not transfer well, though: the per-frame gradient
-//! of a mean over V frames is 1/V of a keyframe's, so dense statements ("wrist above 1.6 m
-//! on every frame") move 1/V as fast, and errors in m², radians or with weights move at
-//! their own scale.
-//!
-//! The default, [`StepRule::Polyak`], keeps OmniControl's schedule and its Σ̂ but sizes each
-//! iteration so that it removes the fraction min(1, τ·Σ̂) of the linearised error of each
-//! sample: `μ ← μ − min(1, τΣ̂)·E/‖∇E‖²·∇E` (0.2 of the error per iteration for t < 807,
-//! all of it while the chain is still very noisy). It is invariant to the error's units,
-//! weights and frame counts, and stops moving a sample whose error is ≤ 0 (satisfied
-//! hinges). With a single keyframe distance it is OmniControl's step with an adaptive τ.
+//! the fused host path ([`super::host`]) by default. Where the reference code and the paper
+//! differ, and the step-size rule ([`StepRule::Polyak`] by default): the book's "`guide`:
+//! paper, code, and the step size".
 
 use super::knobs::{Knob, knob};
 use super::solver::{Solver, SolverConfig, SolverSpec};
