@@ -131,8 +131,10 @@ impl Mdm {
     }
 }
 
-impl Denoiser for Mdm {
-    fn predict_x0(&self, input: &DenoiserInput) -> Tensor<3> {
+impl Mdm {
+    /// The encoder's input: the condition token then the projected frames, positions
+    /// added, dropout applied (`[B, N+1, d]`), with the padding mask of that sequence.
+    pub(crate) fn embed(&self, input: &DenoiserInput) -> (Tensor<3>, Option<Tensor<2, Bool>>) {
         let device = input.x_t.device();
         let [b, n, _] = input.x_t.dims();
         let frames = self.input_proj.forward(input.x_t.clone()); // [B, N, d]
@@ -140,13 +142,23 @@ impl Denoiser for Mdm {
         let seq = Tensor::cat(vec![cond, frames], 1); // [B, N+1, d]
         let pos = sinusoids(0..n + 1, self.d_model, &device).unsqueeze_dim::<3>(0);
         let seq = self.dropout.forward(seq + pos);
-        let mut enc_in = TransformerEncoderInput::new(seq);
-        if let Some(pad) = &input.padding {
+        let mask = input.padding.as_ref().map(|pad| {
             let cond_col =
                 Tensor::<2, Bool>::from_data(TensorData::new(vec![false; b], [b, 1]), &device);
-            enc_in = enc_in.mask_pad(Tensor::cat(vec![cond_col, pad.clone()], 1));
-        }
-        let out = self.encoder.forward(enc_in); // [B, N+1, d]
+            Tensor::cat(vec![cond_col, pad.clone()], 1)
+        });
+        (seq, mask)
+    }
+
+    /// The encoder's layers (a ControlNet adds into the stream after each one).
+    pub(crate) fn encoder(&self) -> &TransformerEncoder {
+        &self.encoder
+    }
+
+    /// x̂0 `[B, N, F]` from the encoder's output `[B, N+1, d]`.
+    pub(crate) fn output(&self, out: Tensor<3>, input: &DenoiserInput) -> Tensor<3> {
+        let device = input.x_t.device();
+        let n = input.x_t.dims()[1];
         let out = self.output_proj.forward(out.narrow(1, 1, n)); // [B, N, F]
         match &self.skip {
             Some(skip) => {
@@ -156,5 +168,17 @@ impl Denoiser for Mdm {
             }
             None => out,
         }
+    }
+}
+
+impl Denoiser for Mdm {
+    fn predict_x0(&self, input: &DenoiserInput) -> Tensor<3> {
+        let (seq, mask) = self.embed(input);
+        let mut enc_in = TransformerEncoderInput::new(seq);
+        if let Some(mask) = mask {
+            enc_in = enc_in.mask_pad(mask);
+        }
+        let out = self.encoder.forward(enc_in); // [B, N+1, d]
+        self.output(out, input)
     }
 }

@@ -5,6 +5,7 @@
 
 pub mod batch;
 pub mod config;
+pub mod control;
 pub mod denoiser;
 pub mod ema;
 pub mod generate;
