@@ -33,6 +33,8 @@ enum Command {
     Bench(cli::bench::BenchCommand),
     /// Train the denoiser on a dataset built by `mprog data build`.
     Train(cli::train::TrainArgs),
+    /// Train a realism ControlNet (OmniControl) on a frozen base bundle, resumable.
+    TrainControl(cli::train_control::TrainControlArgs),
     /// Run a program: generate with the model, steered by the program's error.
     Run(cli::run::RunArgs),
     /// A program's error on a motion file, per statement, with an optional plot over time.
@@ -89,6 +91,7 @@ fn main() -> miette::Result<()> {
         Command::Render(args) => cli::convert::render(args)?,
         Command::View(args) => cli::view::run(args)?,
         Command::Train(args) => cli::train::run(args)?,
+        Command::TrainControl(args) => cli::train_control::run(args)?,
         Command::Bench(cmd) => cli::bench::run(cmd)?,
         Command::Score(args) => cli::score::run(args)?,
         Command::Run(args) => cli::run::run(args)?,

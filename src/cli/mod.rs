@@ -15,6 +15,7 @@ pub mod repl;
 pub mod run;
 pub mod score;
 pub mod train;
+pub mod train_control;
 pub mod view;
 
 /// The burn device of this command: flex, or the GPU backend named by `MPROG_DEVICE`.

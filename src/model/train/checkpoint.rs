@@ -16,7 +16,7 @@ use burn::module::Module;
 use burn::optim::{AdamWConfig, ModuleOptimizer, grad_clipping::GradientClippingConfig};
 use burn::prelude::*;
 use burn::store::{HalfPrecisionAdapter, ModuleRecord, ModuleSnapshot, SafetensorsStore};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Training weights, EMA weights, optimizer and progress.
 pub(super) struct Checkpoint {
@@ -34,10 +34,6 @@ fn new_optimizer(cfg: &TrainConfig) -> ModuleOptimizer {
 }
 
 impl TrainRun<'_> {
-    fn ckpt(&self) -> PathBuf {
-        self.out.join("ckpt")
-    }
-
     /// The complete checkpoint to resume from: `ckpt/`, or `ckpt.old/` when a kill hit
     /// the swap between the two renames.
     fn existing_checkpoint(&self) -> Option<PathBuf> {
@@ -215,18 +211,7 @@ impl TrainRun<'_> {
                 .as_bytes(),
         )
         .map_err(|e| file_err(&p, e))?;
-        let (cur, old) = (self.ckpt(), self.out.join("ckpt.old"));
-        if old.exists() {
-            std::fs::remove_dir_all(&old).map_err(|e| file_err(&old, e))?;
-        }
-        if cur.exists() {
-            std::fs::rename(&cur, &old).map_err(|e| file_err(&cur, e))?;
-        }
-        std::fs::rename(&dir, &cur).map_err(|e| file_err(&dir, e))?;
-        if old.exists() {
-            std::fs::remove_dir_all(&old).map_err(|e| file_err(&old, e))?;
-        }
-        Ok(())
+        swap_in(&self.out, &dir)
     }
 }
 
@@ -253,4 +238,21 @@ fn load_without_text(model: Mdm, bytes: &[u8], half: bool) -> Result<Mdm, String
         ));
     }
     Ok(model)
+}
+
+/// Makes the complete checkpoint folder `new` the run's `ckpt/` by renames: the old one
+/// goes to `ckpt.old/` first, so a kill at any moment leaves one complete checkpoint.
+pub(super) fn swap_in(out: &Path, new: &Path) -> Result<(), TrainError> {
+    let (cur, old) = (out.join("ckpt"), out.join("ckpt.old"));
+    if old.exists() {
+        std::fs::remove_dir_all(&old).map_err(|e| file_err(&old, e))?;
+    }
+    if cur.exists() {
+        std::fs::rename(&cur, &old).map_err(|e| file_err(&cur, e))?;
+    }
+    std::fs::rename(new, &cur).map_err(|e| file_err(new, e))?;
+    if old.exists() {
+        std::fs::remove_dir_all(&old).map_err(|e| file_err(&old, e))?;
+    }
+    Ok(())
 }

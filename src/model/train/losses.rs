@@ -14,7 +14,7 @@ use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT};
 use burn::prelude::*;
 
 /// A batch moved to tensors.
-fn to_device(
+pub(crate) fn to_device(
     batch: &HostBatch,
     text: &TrainText,
     device: &Device,
@@ -46,7 +46,12 @@ fn to_device(
 }
 
 /// Noises x0 to each sample's timestep: x_t = √ᾱ x0 + √(1−ᾱ) ε.
-fn q_sample(schedule: &NoiseSchedule, x0: Tensor<3>, timesteps: &[usize], seed: u64) -> Tensor<3> {
+pub(crate) fn q_sample(
+    schedule: &NoiseSchedule,
+    x0: Tensor<3>,
+    timesteps: &[usize],
+    seed: u64,
+) -> Tensor<3> {
     let device = x0.device();
     let dims = x0.dims();
     let (a, s): (Vec<f32>, Vec<f32>) = timesteps

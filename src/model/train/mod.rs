@@ -23,11 +23,13 @@
 //! | `checkpoint.rs` | where a run starts (fresh, a bundle, its checkpoint); atomic saves |
 //! | `text.rs` | the run's text side: a vocabulary or the embedded captions |
 //! | `log.rs` | `loss.csv` and `val.csv` |
+//! | `control.rs` | a ControlNet trained on a frozen base |
 //!
 //! A checkpoint is written whole into `ckpt.new/` and then swapped in by renames, so a
 //! kill at any moment leaves either the old or the new checkpoint complete.
 
 mod checkpoint;
+pub mod control;
 mod log;
 mod losses;
 pub mod text;

@@ -1,0 +1,508 @@
+//! Training a ControlNet on a frozen base (OmniControl §3.2): each step draws a batch as the
+//! base's training does, takes the hint from the clean motions themselves (one random joint
+//! of pelvis, feet, head and wrists per sample, on a random number of its frames, as
+//! OmniControl's `random_mask_train`), noises the motions and fits the controlled
+//! prediction to the clean motion with the masked x0 MSE. Only the ControlNet learns.
+//!
+//! ```text
+//! <out>/config.toml           ControlTrainConfig (fixed at the first start)
+//! <out>/ckpt/state.json       step, seconds, last loss
+//! <out>/ckpt/control.safetensors, optim.bpk   the training state (f32)
+//! <out>/bundle/               the base bundle's files plus control.safetensors (f16)
+//! <out>/loss.csv              step, loss, learning rate, seconds
+//! ```
+
+use super::checkpoint::swap_in;
+use super::log::append;
+use super::losses::{masked_mse, q_sample, to_device};
+use super::text::TrainText;
+use super::{TrainError, TrainState, file_err};
+use crate::dataset::{ClipInfo, Dataset, Split};
+use crate::features::recover_from_ric_tensor;
+use crate::fsutil::write_bytes_atomic;
+use crate::interrupt::Interrupt;
+use crate::model::batch::{draw_batch, step_rng};
+use crate::model::config::TrainConfig;
+use crate::model::control::{CONTROL_FILE, ControlNet, Controlled, Hint};
+use crate::model::denoiser::{Denoiser, Mdm};
+use crate::model::prompt::PromptEncoder;
+use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use crate::model::weights::{ModelBundle, model_from_safetensors};
+use crate::skeleton::NUM_JOINTS;
+use burn::module::Module;
+use burn::optim::grad_clipping::GradientClippingConfig;
+use burn::optim::{AdamWConfig, GradientsParams, ModuleOptimizer};
+use burn::prelude::*;
+use rand::Rng;
+use rand::seq::index::sample;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Joints a training hint controls (OmniControl's set): pelvis, feet, head, wrists.
+pub const HINT_JOINTS: [usize; 6] = [0, 10, 11, 15, 20, 21];
+
+/// Settings of a ControlNet run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlTrainConfig {
+    /// Clips per batch.
+    pub batch_size: usize,
+    /// Frames per crop.
+    pub crop_frames: usize,
+    /// Peak learning rate (AdamW; OmniControl 1e-5 at batch 64 over 400k steps).
+    pub learning_rate: f64,
+    /// Linear warm-up steps.
+    pub warmup_steps: usize,
+    /// Gradient norm clip.
+    pub grad_clip: f64,
+    /// Probability of dropping the text (the ControlNet must also steer unconditional
+    /// passes of classifier-free guidance).
+    pub cond_drop: f64,
+    /// Total steps.
+    pub steps: usize,
+    /// Checkpoint every this many steps.
+    pub checkpoint_every: usize,
+    /// Seed of the data order, hints and noise.
+    pub seed: u64,
+}
+
+impl Default for ControlTrainConfig {
+    fn default() -> Self {
+        ControlTrainConfig {
+            batch_size: 32,
+            crop_frames: 120,
+            learning_rate: 1e-4,
+            warmup_steps: 200,
+            grad_clip: 1.0,
+            cond_drop: 0.1,
+            steps: 100_000,
+            checkpoint_every: 100,
+            seed: 11,
+        }
+    }
+}
+
+impl ControlTrainConfig {
+    /// The base training settings that draw this run's batches.
+    fn batches(&self) -> TrainConfig {
+        TrainConfig {
+            batch_size: self.batch_size,
+            crop_frames: self.crop_frames,
+            cond_drop: self.cond_drop,
+            seed: self.seed,
+            ..TrainConfig::default()
+        }
+    }
+
+    fn check(&self) -> Result<(), String> {
+        self.batches().check()?;
+        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
+            return Err(format!(
+                "`learning_rate` is {}; it must be a positive number",
+                self.learning_rate
+            ));
+        }
+        if self.checkpoint_every == 0 {
+            return Err("`checkpoint_every` must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// Hints of a batch from its clean joints `[B, N, 22, 3]`: per sample one joint of
+/// [`HINT_JOINTS`] on k of its valid frames, k uniform in 1..=valid−1 (at least 1).
+pub fn training_hint(joints: Tensor<4>, valid_frames: &[usize], rng: &mut impl Rng) -> Hint {
+    let [b, n, _, _] = joints.dims();
+    let mut mask = vec![0.0f32; b * n * NUM_JOINTS];
+    for (i, &len) in valid_frames.iter().enumerate() {
+        let joint = HINT_JOINTS[rng.random_range(0..HINT_JOINTS.len())];
+        let len = len.clamp(1, n);
+        let k = rng.random_range(1..=len.saturating_sub(1).max(1));
+        for f in sample(rng, len, k) {
+            mask[(i * n + f) * NUM_JOINTS + joint] = 1.0;
+        }
+    }
+    let device = joints.device();
+    let mask = Tensor::from_data(TensorData::new(mask, [b, n, NUM_JOINTS]), &device);
+    Hint::new(joints, mask)
+}
+
+/// A ControlNet run on a frozen base bundle.
+pub struct ControlTrainRun<'a> {
+    /// The data (its statistics must be the base's).
+    pub data: &'a Dataset,
+    /// The base bundle's folder.
+    pub base: PathBuf,
+    /// Settings.
+    pub config: ControlTrainConfig,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Stop after this many steps now (None: until `config.steps`).
+    pub max_steps_now: Option<usize>,
+    /// Read between steps: when set, the run checkpoints and returns.
+    pub interrupt: Interrupt,
+    /// Device (without autodiff; the run adds it).
+    pub device: Device,
+}
+
+struct ControlState {
+    control: ControlNet,
+    optim: ModuleOptimizer,
+    state: TrainState,
+}
+
+fn new_optimizer(cfg: &ControlTrainConfig) -> ModuleOptimizer {
+    AdamWConfig::new()
+        .with_grad_clipping(Some(GradientClippingConfig::Norm(cfg.grad_clip as f32)))
+        .init()
+}
+
+impl ControlTrainRun<'_> {
+    /// Trains until `config.steps` (or `max_steps_now` more), resuming from `out/ckpt`.
+    pub fn run(&self, progress: &dyn Fn(&TrainState, f32, f64)) -> Result<TrainState, TrainError> {
+        let cfg = &self.config;
+        cfg.check()
+            .map_err(|e| TrainError::Invalid(format!("ControlNet config: {e}")))?;
+        let plain = self.device.clone();
+        let bundle = ModelBundle::load(&self.base, &plain).map_err(|e| file_err(&self.base, e))?;
+        self.check_statistics(&bundle)?;
+        let train: Vec<&ClipInfo> = self.data.clips(Split::Train).collect();
+        if train.is_empty() {
+            return Err(TrainError::Invalid(
+                "the dataset has no training clips".into(),
+            ));
+        }
+        let device = plain.clone().autodiff();
+        let base = self.frozen_base(&bundle, &device)?;
+        let text = match &bundle.text {
+            PromptEncoder::Words(v) => TrainText::Words(v.clone()),
+            PromptEncoder::Sentences(s) => {
+                TrainText::sentences(s.encoder.clone(), s.captions.clone())
+            }
+        };
+        let mut ck = self.load_or_init(&base, &device)?;
+        let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
+        let batches = cfg.batches();
+        let stop_at = self
+            .max_steps_now
+            .map_or(cfg.steps, |n| (ck.state.step + n).min(cfg.steps));
+        let (mut pending, mut sum, mut count) = (String::new(), 0.0f64, 0usize);
+        let mut clock = Instant::now();
+        let mut saved_at = ck.state.step;
+        while ck.state.step < stop_at && !self.interrupt.is_requested() {
+            let step = ck.state.step;
+            let batch = draw_batch(self.data, &train, &batches, step);
+            let (mut input, x0, valid) = to_device(&batch, &text, &device);
+            let mean = stat(&bundle.mean, &device);
+            let std = stat(&bundle.std, &device);
+            let joints = recover_from_ric_tensor(x0.clone() * std + mean);
+            let lengths: Vec<usize> = batch
+                .padding
+                .chunks(batch.frames)
+                .map(|p| p.iter().filter(|&&pad| !pad).count())
+                .collect();
+            let mut rng = step_rng(cfg.seed ^ 0xC0_17_20_1E, step);
+            let hint = training_hint(joints, &lengths, &mut rng);
+            input.x_t = q_sample(&schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
+            let pred = Controlled {
+                base: &base,
+                control: &ck.control,
+                hint,
+            }
+            .predict_x0(&input);
+            let loss = masked_mse(pred, x0, valid);
+            let value = loss.clone().into_scalar::<f32>();
+            if !value.is_finite() {
+                return Err(TrainError::Diverged { step, loss: value });
+            }
+            let grads = GradientsParams::from_grads(loss.backward(), &ck.control);
+            let warm = ((step + 1) as f64 / cfg.warmup_steps.max(1) as f64).min(1.0);
+            let lr = cfg.learning_rate * warm;
+            ck.control = ck.optim.step(lr, ck.control, grads);
+            ck.state.step += 1;
+            let now = Instant::now();
+            ck.state.seconds += (now - clock).as_secs_f64();
+            clock = now;
+            (sum, count) = (sum + value as f64, count + 1);
+            pending.push_str(&format!(
+                "{},{value},{lr},{:.1}\n",
+                ck.state.step, ck.state.seconds
+            ));
+            progress(&ck.state, value, lr);
+            if ck.state.step % cfg.checkpoint_every == 0 || ck.state.step == stop_at {
+                ck.state.recent_loss = sum / count.max(1) as f64;
+                (sum, count) = (0.0, 0);
+                append(
+                    &self.out.join("loss.csv"),
+                    "step,loss,lr,seconds\n",
+                    &pending,
+                )?;
+                pending.clear();
+                self.save(&ck)?;
+                saved_at = ck.state.step;
+                clock = Instant::now();
+            }
+        }
+        if ck.state.step > saved_at {
+            ck.state.recent_loss = sum / count.max(1) as f64;
+            append(
+                &self.out.join("loss.csv"),
+                "step,loss,lr,seconds\n",
+                &pending,
+            )?;
+            self.save(&ck)?;
+        }
+        Ok(ck.state)
+    }
+
+    /// The ControlNet learns to steer the base as it was trained: on data normalised with
+    /// the base's own statistics.
+    fn check_statistics(&self, bundle: &ModelBundle) -> Result<(), TrainError> {
+        let differs = |a: &[f32], b: &[f32]| {
+            a.len() != b.len() || a.iter().zip(b).any(|(x, y)| (x - y).abs() > 1e-4)
+        };
+        if differs(&self.data.mean, &bundle.mean) || differs(&self.data.std, &bundle.std) {
+            return Err(TrainError::Invalid(format!(
+                "the dataset's mean/std are not the ones {} was trained with: train the ControlNet on its base's training set",
+                self.base.display()
+            )));
+        }
+        Ok(())
+    }
+
+    /// The base on the training device, its weights excluded from the gradients.
+    fn frozen_base(&self, bundle: &ModelBundle, device: &Device) -> Result<Mdm, TrainError> {
+        let path = self.base.join("model.safetensors");
+        let bytes = std::fs::read(&path).map_err(|e| file_err(&path, e))?;
+        let vocab_size = match &bundle.text {
+            PromptEncoder::Words(v) => v.len(),
+            PromptEncoder::Sentences(_) => 0,
+        };
+        let fresh = Mdm::new(&bundle.config, vocab_size, device);
+        let base = model_from_safetensors(fresh, bytes, bundle.manifest.half_precision)
+            .map_err(|e| file_err(&path, e))?;
+        // Dropout off, no gradients: the base is a fixed function here.
+        Ok(base.no_grad())
+    }
+
+    fn load_or_init(&self, base: &Mdm, device: &Device) -> Result<ControlState, TrainError> {
+        let dir = self.out.join("ckpt");
+        let state_path = dir.join("state.json");
+        if !state_path.exists() {
+            return Ok(ControlState {
+                control: ControlNet::from_base(base, device),
+                optim: new_optimizer(&self.config),
+                state: TrainState::default(),
+            });
+        }
+        let text = std::fs::read_to_string(&state_path).map_err(|e| file_err(&state_path, e))?;
+        let state: TrainState =
+            serde_json::from_str(&text).map_err(|e| file_err(&state_path, e))?;
+        let control = ControlNet::load(&dir, base, false, device)
+            .map_err(|e| file_err(&dir, e))?
+            .ok_or_else(|| file_err(&dir, format!("no {CONTROL_FILE}")))?;
+        let optim_path = dir.join("optim.bpk");
+        let optim = new_optimizer(&self.config)
+            .load(&optim_path)
+            .map_err(|e| file_err(&optim_path, format!("{e:?}")))?;
+        Ok(ControlState {
+            control,
+            optim,
+            state,
+        })
+    }
+
+    fn save(&self, ck: &ControlState) -> Result<(), TrainError> {
+        let new = self.out.join("ckpt.new");
+        if new.exists() {
+            std::fs::remove_dir_all(&new).map_err(|e| file_err(&new, e))?;
+        }
+        std::fs::create_dir_all(&new).map_err(|e| file_err(&new, e))?;
+        ck.control
+            .save(&new, false)
+            .map_err(|e| file_err(&new, e))?;
+        let p = new.join("optim.bpk");
+        let bytes = ck
+            .optim
+            .into_bytes()
+            .map_err(|e| file_err(&p, format!("{e:?}")))?;
+        write_bytes_atomic(&p, &bytes).map_err(|e| file_err(&p, e))?;
+        let p = new.join("state.json");
+        let json = serde_json::to_string_pretty(&ck.state).expect("state serialises");
+        write_bytes_atomic(&p, json.as_bytes()).map_err(|e| file_err(&p, e))?;
+        swap_in(&self.out, &new)?;
+        // The shippable bundle: the base's files with the ControlNet beside them.
+        let bundle = self.out.join("bundle");
+        std::fs::create_dir_all(&bundle).map_err(|e| file_err(&bundle, e))?;
+        copy_bundle_files(&self.base, &bundle)?;
+        ck.control
+            .save(&bundle, true)
+            .map_err(|e| file_err(&bundle, e))
+    }
+}
+
+fn stat(v: &[f32], device: &Device) -> Tensor<3> {
+    Tensor::from_data(TensorData::new(v.to_vec(), [1, 1, v.len()]), device)
+}
+
+/// Copies every file of a bundle folder (not its subfolders, not a ControlNet) to `to`.
+fn copy_bundle_files(from: &Path, to: &Path) -> Result<(), TrainError> {
+    let entries = std::fs::read_dir(from).map_err(|e| file_err(from, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| file_err(from, e))?;
+        let path = entry.path();
+        let name = entry.file_name();
+        if !path.is_file() || name == CONTROL_FILE {
+            continue;
+        }
+        let bytes = std::fs::read(&path).map_err(|e| file_err(&path, e))?;
+        let dst = to.join(&name);
+        write_bytes_atomic(&dst, &bytes).map_err(|e| file_err(&dst, e))?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::{synthetic_dataset, tiny};
+    use crate::model::train::TrainRun;
+
+    #[test]
+    fn training_hints_control_one_listed_joint_on_some_valid_frames() {
+        let dev = Device::flex();
+        let joints = crate::model::noise::NoiseSource::new(1).tensor([3, 10, NUM_JOINTS, 3], &dev);
+        let mut rng = step_rng(4, 0);
+        let hint = training_hint(joints, &[10, 6, 1], &mut rng);
+        let v = hint.values.into_data().try_to_vec::<f32>().unwrap();
+        for (i, len) in [10usize, 6, 1].into_iter().enumerate() {
+            let mut frames = 0;
+            let mut joints_seen = std::collections::BTreeSet::new();
+            for f in 0..10 {
+                let row = &v[(i * 10 + f) * 88..][..88];
+                for (j, &m) in row[66..].iter().enumerate() {
+                    if m == 1.0 {
+                        assert!(f < len, "sample {i}: frame {f} is padding");
+                        joints_seen.insert(j);
+                        frames += 1;
+                    } else {
+                        assert_eq!(m, 0.0);
+                        assert_eq!(&row[3 * j..3 * j + 3], &[0.0; 3], "free joints are zero");
+                    }
+                }
+            }
+            assert_eq!(joints_seen.len(), 1, "{joints_seen:?}");
+            assert!(HINT_JOINTS.contains(joints_seen.first().unwrap()));
+            assert!(
+                frames >= 1 && frames <= len.saturating_sub(1).max(1),
+                "{frames} of {len}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_control_net_trains_on_a_frozen_base_and_resumes() {
+        let data = synthetic_dataset();
+        let base_run = tempfile::tempdir().unwrap();
+        TrainRun {
+            data: &data,
+            config: TrainConfig {
+                model: tiny(),
+                batch_size: 2,
+                crop_frames: 8,
+                warmup_steps: 1,
+                checkpoint_every: 5,
+                steps: 5,
+                ..TrainConfig::default()
+            },
+            out: base_run.path().to_path_buf(),
+            max_steps_now: None,
+            interrupt: Default::default(),
+            init_from: None,
+            device: Device::flex(),
+            after_checkpoint: None,
+            text_encoder: None,
+        }
+        .run(&|_, _, _| {})
+        .unwrap();
+        let base = base_run.path().join("bundle");
+        let before = std::fs::read(base.join("model.safetensors")).unwrap();
+        let out = tempfile::tempdir().unwrap();
+        let run = |steps| ControlTrainRun {
+            data: &data,
+            base: base.clone(),
+            config: ControlTrainConfig {
+                batch_size: 2,
+                crop_frames: 8,
+                learning_rate: 1e-3,
+                warmup_steps: 1,
+                checkpoint_every: 4,
+                steps: 100,
+                ..ControlTrainConfig::default()
+            },
+            out: out.path().to_path_buf(),
+            max_steps_now: Some(steps),
+            interrupt: Default::default(),
+            device: Device::flex(),
+        };
+        assert_eq!(run(6).run(&|_, _, _| {}).unwrap().step, 6);
+        assert_eq!(run(4).run(&|_, _, _| {}).unwrap().step, 10, "resumed");
+        let csv = std::fs::read_to_string(out.path().join("loss.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + 10);
+        // The base is untouched; the exported bundle is the base plus a ControlNet that
+        // has learned something (its zero layers moved).
+        assert_eq!(
+            std::fs::read(base.join("model.safetensors")).unwrap(),
+            before
+        );
+        let dev = Device::flex();
+        let bundle = ModelBundle::load(&out.path().join("bundle"), &dev).unwrap();
+        let control = ControlNet::load(&out.path().join("bundle"), &bundle.model, true, &dev)
+            .unwrap()
+            .expect("the bundle has its ControlNet");
+        let fresh = ControlNet::from_base(&bundle.model, &dev);
+        let bytes = |c: &ControlNet| crate::model::weights::module_to_safetensors(c, true).unwrap();
+        assert_ne!(bytes(&control), bytes(&fresh));
+    }
+
+    #[test]
+    fn a_control_net_is_refused_data_with_other_statistics() {
+        let mut data = synthetic_dataset();
+        let base_run = tempfile::tempdir().unwrap();
+        TrainRun {
+            data: &data,
+            config: TrainConfig {
+                model: tiny(),
+                batch_size: 2,
+                crop_frames: 8,
+                checkpoint_every: 2,
+                steps: 2,
+                ..TrainConfig::default()
+            },
+            out: base_run.path().to_path_buf(),
+            max_steps_now: None,
+            interrupt: Default::default(),
+            init_from: None,
+            device: Device::flex(),
+            after_checkpoint: None,
+            text_encoder: None,
+        }
+        .run(&|_, _, _| {})
+        .unwrap();
+        data.std[5] = 2.0;
+        let out = tempfile::tempdir().unwrap();
+        let err = ControlTrainRun {
+            data: &data,
+            base: base_run.path().join("bundle"),
+            config: ControlTrainConfig::default(),
+            out: out.path().to_path_buf(),
+            max_steps_now: Some(1),
+            interrupt: Default::default(),
+            device: Device::flex(),
+        }
+        .run(&|_, _, _| {})
+        .unwrap_err();
+        assert!(err.to_string().contains("mean/std"), "{err}");
+    }
+}
