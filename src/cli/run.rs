@@ -10,6 +10,7 @@ use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::formats::Meta;
 use mprog::lang::Program;
 use mprog::model::ModelBundle;
+use mprog::model::control::ControlNet;
 use mprog::model::weights::default_model_dir;
 use mprog::motion::Motion;
 use mprog::solve::{Prior, Progress, SolveRequest, SolveResult, Solver, solve};
@@ -97,6 +98,7 @@ fn per_statement(program: &Program, people: &[Motion], device: &Device) -> Resul
 
 fn solve_with_bar(
     bundle: &ModelBundle,
+    control: Option<&ControlNet>,
     req: &SolveRequest,
     program: &Program,
     device: &Device,
@@ -111,7 +113,7 @@ fn solve_with_bar(
     );
     let error: &dyn mprog::solve::MotionError = program;
     let out = solve(
-        &Prior::from_bundle(bundle),
+        &Prior::from_bundle(bundle).with_control(control),
         req,
         error,
         device,
@@ -161,6 +163,9 @@ pub fn run(args: RunArgs) -> Result<()> {
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
+    // A realism ControlNet beside the weights steers `guide` (knob `realism`).
+    let control = ControlNet::load(&dir, &bundle.model, bundle.manifest.half_precision, &device)
+        .into_diagnostic()?;
     let several = prompts.len() > 1;
     for (person, prompt) in program.people().iter().zip(&prompts) {
         for line in bundle.text.report(prompt) {
@@ -174,7 +179,14 @@ pub fn run(args: RunArgs) -> Result<()> {
     let frames = program.length();
     let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.clone())
         .placed(program.placements());
-    let result = solve_with_bar(&bundle, &req, &program, &device, solver.name())?;
+    let result = solve_with_bar(
+        &bundle,
+        control.as_ref(),
+        &req,
+        &program,
+        &device,
+        solver.name(),
+    )?;
     let people = &result.motions[0];
     let guided = per_statement(&program, people, &device)?;
     let baseline = if args.no_baseline {
@@ -182,7 +194,14 @@ pub fn run(args: RunArgs) -> Result<()> {
     } else {
         let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.unguided())
             .placed(program.placements());
-        let r = solve_with_bar(&bundle, &req, &program, &device, "unguided")?;
+        let r = solve_with_bar(
+            &bundle,
+            control.as_ref(),
+            &req,
+            &program,
+            &device,
+            "unguided",
+        )?;
         Some((per_statement(&program, &r.motions[0], &device)?, r.seconds))
     };
     println!("| line | statement | unit | unguided | {} |", solver.name());

@@ -33,7 +33,8 @@ use super::host::{HEAD, HostObjective, TermGradients, check_shape, extract_head,
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
-use crate::model::sampler::{guided_x0, posterior_mean};
+use super::realism::Realism;
+use crate::model::sampler::posterior_mean;
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use burn::prelude::*;
 
@@ -113,6 +114,9 @@ pub struct GuideConfig {
     /// does not make is met by walking the people into each other. Small values make the
     /// late steps meet it with the pose instead (see the module notes). Default 0.01.
     pub late_root_scale: f32,
+    /// Steer every denoising step through the prior's ControlNet with a hint derived from
+    /// the program ([`super::realism`]); acts only when the bundle has a ControlNet.
+    pub realism: bool,
 }
 
 impl Default for GuideConfig {
@@ -134,6 +138,7 @@ impl Default for GuideConfig {
             early_root_only: true,
             split_terms: true,
             late_root_scale: 0.01,
+            realism: true,
         }
     }
 }
@@ -233,8 +238,9 @@ fn run(
     let mut objective = ctx.host_objective();
     let mut x = ctx.initial_tensor(&ctx.device);
     let mut trace = Vec::with_capacity(n);
+    let mut realism = Realism::new(ctx, ctx.prior.control.filter(|_| cfg.realism));
     for i in (0..n).rev() {
-        let x0 = guided_x0(&den, x.clone(), schedule.timesteps[i], &cond);
+        let x0 = realism.x0(&den, x.clone(), schedule.timesteps[i], &cond);
         let mut mu = posterior_mean(&schedule, i, x, x0);
         let k = cfg.iterations_at(i);
         let post = schedule.posterior(i);
@@ -243,6 +249,7 @@ fn run(
         let mut last = None;
         if k > 0 {
             let mut full = host(mu);
+            let before = realism.is_on().then(|| full.clone());
             let values = if cfg.fused {
                 let late = i < cfg.late_steps;
                 let inner = Inner {
@@ -255,6 +262,9 @@ fn run(
             } else {
                 guide_graph(ctx, cfg, &mut full, k, step, i, &at)?
             };
+            if let Some(before) = before {
+                realism.update(ctx, &before, &full)?;
+            }
             mu = Tensor::from_data(TensorData::new(full, dims), &ctx.device);
             last = Some(mean(&values));
             trace.push(values);
@@ -609,6 +619,12 @@ impl SolverConfig for GuideConfig {
             "split",
             "1: in the last `late_steps`, each statement gets its own step size and the iteration steps along their sum; 0: one step for the whole error, as OmniControl",
             split_terms
+        ),
+        knob!(
+            Flag("off", "through the ControlNet"),
+            "realism",
+            "1: when the model has a ControlNet, every denoising step's x̂0 is steered by it with a hint taken from the program's gradient and the inner loop's iterate (OmniControl's realism guidance); 0: off",
+            realism
         ),
         knob!(Real, "late_root", "share of the root columns (path) in each step of the last `late_steps`, 0–1: the late steps meet contacts and keyframes with the pose instead of by moving the people; 1: OmniControl's plain gradient", late_root_scale),
     ];

@@ -51,6 +51,7 @@ mod decode;
 pub mod feet;
 pub mod host;
 pub mod knobs;
+mod realism;
 pub mod reference;
 mod request;
 mod run;

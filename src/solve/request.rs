@@ -2,6 +2,7 @@
 //! ([`Prior`]), what comes back ([`SolveResult`]) and progress reports ([`Progress`]).
 
 use super::solver::Solver;
+use crate::model::control::ControlNet;
 use crate::model::prompt::PromptEncoder;
 use crate::model::{Mdm, ModelBundle};
 use crate::motion::Motion;
@@ -20,6 +21,8 @@ pub struct Prior<'a> {
     pub std: &'a [f32],
     /// Longest motion the model generates (frames).
     pub max_frames: usize,
+    /// The realism ControlNet trained on this denoiser, when the bundle has one.
+    pub control: Option<&'a ControlNet>,
 }
 
 impl<'a> Prior<'a> {
@@ -31,7 +34,13 @@ impl<'a> Prior<'a> {
             mean: &bundle.mean,
             std: &bundle.std,
             max_frames: bundle.config.max_frames,
+            control: None,
         }
+    }
+
+    /// The same prior steered by `control` (see `guide`'s `realism`).
+    pub fn with_control(self, control: Option<&'a ControlNet>) -> Self {
+        Prior { control, ..self }
     }
 }
 
