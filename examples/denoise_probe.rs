@@ -16,7 +16,6 @@ use mprog::model::denoiser::{Denoiser, DenoiserInput};
 use mprog::model::noise::NoiseSource;
 use mprog::model::sampler::{Condition, ddim_step, guided_x0};
 use mprog::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
-use mprog::model::text::TokenBatch;
 use mprog::motion::Motion;
 use std::path::PathBuf;
 
@@ -95,7 +94,7 @@ fn main() {
         let input = DenoiserInput {
             x_t,
             timesteps: vec![t; b],
-            tokens: TokenBatch::new(&bundle.vocab, &captions, &device),
+            text: bundle.text.batch(&captions, &device),
             keep_text: Tensor::ones([b], &device),
             padding: None,
         };
@@ -129,7 +128,7 @@ fn main() {
             "\nDDIM 50 from noise, guidance {scale}: step t, jitter of x̂0, jitter of x_t read as a motion"
         );
         let ddim = schedule.respaced(50);
-        let cond = Condition::new(&bundle.vocab, &captions, scale, &device);
+        let cond = Condition::new(&bundle.text, &captions, scale, &device);
         let mut x = NoiseSource::new(1).tensor([b, FRAMES, FEATURE_DIM], &device);
         for i in (0..ddim.len()).rev() {
             let t = ddim.timesteps[i];

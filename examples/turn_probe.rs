@@ -40,7 +40,8 @@ fn main() {
     let mut bundle = ModelBundle::load(&PathBuf::from(&args[1]), &device).expect("bundle");
     if let Ok(raw) = std::env::var("RAW") {
         let record = ModuleRecord::load(PathBuf::from(raw)).expect("training weights");
-        bundle.model = Mdm::new(&bundle.config, bundle.vocab.len(), &device).load_record(record);
+        bundle.model =
+            Mdm::new(&bundle.config, vocab_size(&bundle.text), &device).load_record(record);
     }
     let data = Dataset::load(&PathBuf::from(&args[2])).expect("dataset");
     let clips: Vec<_> = data
@@ -82,7 +83,7 @@ fn main() {
     let clean: Tensor<3> =
         Tensor::from_data(TensorData::new(x0, [b, FRAMES, FEATURE_DIM]), &device);
     let captions: Vec<&str> = clips.iter().map(|c| c.captions[0].as_str()).collect();
-    let cond = Condition::new(&bundle.vocab, &captions, 2.5, &device);
+    let cond = Condition::new(&bundle.text, &captions, 2.5, &device);
     println!(
         "{}: {b} turning test clips, {FRAMES} frames; clean mean |turn| {:.1}°",
         bundle.manifest.weights_id,
@@ -118,12 +119,12 @@ fn main() {
         Tensor::zeros([b, FRAMES, 1], &device) - (mean[0] / std[0]),
     );
     let walk = Condition::new(
-        &bundle.vocab,
+        &bundle.text,
         &vec!["a person walks forward"; b],
         2.5,
         &device,
     );
-    let uncond = Condition::new(&bundle.vocab, &captions, 0.0, &device);
+    let uncond = Condition::new(&bundle.text, &captions, 0.0, &device);
     println!(
         "\nt 1: yaw column of x_t zeroed {:.1}; caption \"a person walks forward\" {:.1}; unconditional {:.1}",
         turn(guided_x0(&bundle.model, zero_yaw, 1, &cond)),
@@ -155,4 +156,12 @@ fn main() {
         };
     }
     println!("final sample: {:.1}", turn(x));
+}
+
+/// Ids of a bag-of-words model's word table (none for a sentence model).
+fn vocab_size(text: &mprog::model::prompt::PromptEncoder) -> usize {
+    match text {
+        mprog::model::prompt::PromptEncoder::Words(v) => v.len(),
+        mprog::model::prompt::PromptEncoder::Sentences(_) => 0,
+    }
 }

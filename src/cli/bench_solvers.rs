@@ -9,6 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use mprog::lang::Program;
 use mprog::model::ModelBundle;
+use mprog::model::control::ControlNet;
 use mprog::model::weights::default_model_dir;
 use mprog::solve::{GuideConfig, LatentConfig, Prior, Progress, SolveRequest, Solver, solve};
 use std::fmt::Write as _;
@@ -33,6 +34,10 @@ pub struct SolverBenchArgs {
     /// Model bundle (default: the shipped model).
     #[arg(long)]
     model: Option<PathBuf>,
+    /// Time realism guidance with a zero-initialised ControlNet when the bundle has none:
+    /// what it costs does not depend on its training.
+    #[arg(long)]
+    fresh_control: bool,
     /// Write the markdown here (atomically) as well as to stdout.
     #[arg(short, long)]
     out: Option<PathBuf>,
@@ -44,8 +49,10 @@ struct Timed {
     error: f32,
 }
 
+#[allow(clippy::too_many_arguments)]
 fn timed(
     bundle: &ModelBundle,
+    control: Option<&ControlNet>,
     program: &Program,
     prompts: &[String],
     seed: u64,
@@ -64,7 +71,7 @@ fn timed(
         .placed(program.placements());
     let error: &dyn mprog::solve::MotionError = program;
     let out = solve(
-        &Prior::from_bundle(bundle),
+        &Prior::from_bundle(bundle).with_control(control),
         &req,
         error,
         device,
@@ -97,9 +104,25 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model")?;
+    let control =
+        match ControlNet::load(&dir, &bundle.model, bundle.manifest.half_precision, &device)
+            .into_diagnostic()?
+        {
+            Some(c) => Some(c),
+            None => args
+                .fresh_control
+                .then(|| ControlNet::from_base(&bundle.model, &device)),
+        };
     let run = |solver: Solver, label: &str| {
         timed(
-            &bundle, &program, &prompts, args.seed, solver, label, &device,
+            &bundle,
+            control.as_ref(),
+            &program,
+            &prompts,
+            args.seed,
+            solver,
+            label,
+            &device,
         )
     };
 
@@ -108,7 +131,24 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
         Solver::new(guide.clone()).unguided(),
         &format!("plain DDPM-{}", guide.steps),
     )?;
-    let guided = run(Solver::new(guide.clone()), "guide (fused inner loop)")?;
+    let guided = run(
+        Solver::new(guide.clone()),
+        if control.is_some() {
+            "guide (fused inner loop, realism)"
+        } else {
+            "guide (fused inner loop)"
+        },
+    )?;
+    let no_realism = match &control {
+        Some(_) => Some(run(
+            Solver::new(GuideConfig {
+                realism: false,
+                ..guide.clone()
+            }),
+            "guide (realism=0)",
+        )?),
+        None => None,
+    };
     let tape = if args.skip_tape {
         None
     } else {
@@ -182,6 +222,9 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
     };
     row(&mut md, &plain_ddpm, None);
     row(&mut md, &guided, Some(&plain_ddpm));
+    if let Some(t) = &no_realism {
+        row(&mut md, t, Some(&plain_ddpm));
+    }
     if let Some(t) = &tape {
         row(&mut md, t, Some(&plain_ddpm));
     }

@@ -120,7 +120,7 @@ pub enum PromptEncoder {
     /// A bag-of-words model's vocabulary.
     Words(Vocabulary),
     /// A sentence-encoder model's encoder and training captions.
-    Sentences(SentencePrompts),
+    Sentences(Box<SentencePrompts>),
 }
 
 impl PromptEncoder {

@@ -330,10 +330,10 @@ fn load_prompt_encoder(
     let captions_path = dir.join("captions.safetensors");
     let captions = CaptionIndex::load(&captions_path, device)
         .map_err(|e| mismatch(&captions_path, e.to_string()))?;
-    Ok(PromptEncoder::Sentences(SentencePrompts {
+    Ok(PromptEncoder::Sentences(Box::new(SentencePrompts {
         encoder: std::sync::Arc::new(encoder),
         captions,
-    }))
+    })))
 }
 
 /// The sentence encoder folder for a bundle: `<dir>/text-encoder`, `<dir>/../text-encoder`,

@@ -43,7 +43,8 @@ use super::host::{HEAD, check_shape, extract_head, insert_head};
 use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
-use crate::model::sampler::{guided_x0, posterior_mean};
+use super::realism::Realism;
+use crate::model::sampler::posterior_mean;
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use burn::module::Param;
 use burn::optim::{GradientsParams, LBFGSConfig, LineSearchFn};
@@ -78,6 +79,9 @@ pub struct LbfgsConfig {
     /// L-BFGS then optimises y in μ + S·y, S the smoothing: a keyframe edit spreads over
     /// its neighbours instead of a one-frame spike, as `guide`'s smoothed late steps.
     pub smooth_frames: f32,
+    /// Steer every denoising step through the prior's ControlNet with a hint derived from
+    /// the program, as `guide` does ([`super::realism`]); acts only with a ControlNet.
+    pub realism: bool,
 }
 
 impl Default for LbfgsConfig {
@@ -93,6 +97,7 @@ impl Default for LbfgsConfig {
             keep_skeleton: true,
             early_root_only: false,
             smooth_frames: 4.0,
+            realism: true,
         }
     }
 }
@@ -158,9 +163,11 @@ fn run(
     let mut x = ctx.initial_tensor(&ctx.device);
     let mut trace = Vec::with_capacity(n);
     let early_mask = cfg.early_root_only.then(|| root_mask(&ctx.device));
+    let mut realism = Realism::new(ctx, ctx.prior.control.filter(|_| cfg.realism));
     for i in (0..n).rev() {
-        let x0 = guided_x0(&den, x.clone(), schedule.timesteps[i], &cond);
+        let x0 = realism.x0(&den, x.clone(), schedule.timesteps[i], &cond);
         let mu = posterior_mean(&schedule, i, x, x0);
+        let before = (realism.is_on() && (cfg.k_first > 0 || cfg.k_last > 0)).then(|| host(mu.clone()));
         let k = if i < cfg.late_steps {
             cfg.k_last
         } else {
@@ -298,6 +305,9 @@ fn run(
             None
         };
         ensure_finite(&host(mu.clone()), "lbfgs", "sample", at)?;
+        if let Some(before) = before {
+            realism.update(ctx, &before, &host(mu.clone()))?;
+        }
         x = if i > 0 {
             mu + noise.tensor(dims, &ctx.device) * schedule.posterior(i).variance.sqrt()
         } else {
@@ -327,6 +337,12 @@ pub const SPECS: &[SolverSpec] = &[SolverSpec {
 impl SolverConfig for LbfgsConfig {
     const KNOBS: &'static [Knob<Self>] = &[
         knob!(Count, "steps", "DDPM steps (fewer = respaced chain)", steps),
+        knob!(
+            Flag("off", "through the ControlNet"),
+            "realism",
+            "1: when the model has a ControlNet, every denoising step's x̂0 is steered by it with a hint from the program (as guide's); 0: off",
+            realism
+        ),
         knob!(Count, "k_first", "L-BFGS `step` calls per denoising step before the last `late_steps`", k_first),
         knob!(Count, "k_last", "`step` calls on each of the last `late_steps` (InterControl's 10; the smoothed late steps need more for one-frame targets)", k_last),
         knob!(Count, "late_steps", "T_s", late_steps),

@@ -22,7 +22,7 @@ pub enum TrainText {
     /// Frozen sentence encoder; `rows` maps each indexed caption to its row.
     Sentences {
         /// Encoder and caption index (also what the bundle ships).
-        prompts: SentencePrompts,
+        prompts: Box<SentencePrompts>,
         /// Caption → row of `prompts.captions`.
         rows: HashMap<String, usize>,
     },
@@ -38,7 +38,7 @@ impl TrainText {
             .map(|(i, c)| (c.clone(), i))
             .collect();
         TrainText::Sentences {
-            prompts: SentencePrompts { encoder, captions },
+            prompts: Box::new(SentencePrompts { encoder, captions }),
             rows,
         }
     }
