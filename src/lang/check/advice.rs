@@ -48,8 +48,9 @@ pub fn warnings(ir: &Ir) -> Vec<Diagnostic> {
             )
             .label("out of reach from the start")
             .help(format!(
-                "standing, the {} reaches {:.2} m from the {} (which leans or sways about \
-                 {:.1} m and crouches). Bring the place closer to where the person starts, or \
+                "without a step, the {} reaches {:.2} m along the ground from the {} (which \
+                 leans or sways about {:.1} m; heights are free: crouching and jumping are not \
+                 steps). Bring the place closer to where the person starts, or \
                  ask for the step: say where the pelvis goes by then, e.g. \
                  `at end {{ groundDist(pelvis, [0, 0, 0.5]) < 20 cm }}`",
                 r.joint,

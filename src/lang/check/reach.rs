@@ -1,6 +1,6 @@
 //! Warnings about constraints that put one joint in a place: `mprog::out_of_reach` (the
-//! place is out of reach of a person who does not step, and nothing in the program moves
-//! the pelvis) and `mprog::frame_jump` (two such places, or one and the pinned start place,
+//! place is, on the ground, farther than a limb reaches from where it starts, so it needs a
+//! step, and nothing in the program moves the pelvis) and `mprog::frame_jump` (two such places, or one and the pinned start place,
 //! that the joint can only get between faster than 4 m/s, e.g. 24 cm in one frame).
 //!
 //! A statement's *target* is a box holding every place its joint can be with the
@@ -25,8 +25,6 @@ pub const JUMP_PER_FRAME: f64 = 0.2;
 /// How far a standing person's shoulders and hips move sideways without a step (m): lean,
 /// sway and turning in place.
 pub const SWAY: f64 = 0.2;
-/// How far they go down in a crouch or a bend, and up on tiptoe (m).
-const CROUCH: (f64, f64) = (0.8, 0.1);
 
 /// A box of places one joint must be in on some frames.
 #[derive(Clone, Debug, PartialEq)]
@@ -196,9 +194,11 @@ pub fn out_of_reach(ir: &Ir) -> Vec<OutOfReach> {
             let (a, x, height) = anchor(t.joint);
             let start = starts.get(t.person).copied().unwrap_or(Placement::IDENTITY);
             let at = start.apply(glam::Vec3::new(x as f32, height as f32, 0.0));
-            let (x, y, z) = (f64::from(at.x), f64::from(at.y), f64::from(at.z));
-            let region_lo = [x - SWAY, y - CROUCH.0, z - SWAY];
-            let region_hi = [x + SWAY, y + CROUCH.1, z + SWAY];
+            // On the ground only: crouching, bending and jumping change heights, and only
+            // a step moves the shoulders or hips farther than a lean.
+            let (x, z) = (f64::from(at.x), f64::from(at.z));
+            let region_lo = [x - SWAY, f64::NEG_INFINITY, z - SWAY];
+            let region_hi = [x + SWAY, f64::INFINITY, z + SWAY];
             let reach = chain_length(t.joint, a);
             let beyond = gap((&t.lo, &t.hi), (&region_lo, &region_hi)) - reach;
             (beyond > 0.01).then(|| OutOfReach {
