@@ -170,3 +170,73 @@ fn paths_out_of_the_output_folder_are_refused() {
     assert_eq!(diags[0]["code"], "mprog::unknown_joint");
     assert!(!dir.path().join("x.json").exists() && !out.join("x.json").exists());
 }
+
+/// A stand-in for `mprog run`: logs `start`, sleeps 30 s when asked for seed 1 (at once
+/// otherwise), logs `end` and writes an empty report.
+fn fake_runner(dir: &std::path::Path) -> std::path::PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let exe = dir.join("fake-mprog");
+    let log = dir.join("log");
+    let script = format!(
+        "#!/bin/sh\necho start >> {log}\nreport=\nslow=\n\
+         while [ $# -gt 0 ]; do\n  [ \"$1\" = --report ] && report=\"$2\"\n  \
+         [ \"$1\" = --seed ] && [ \"$2\" = 1 ] && slow=1\n  shift\ndone\n\
+         [ -n \"$slow\" ] && sleep 30\necho end >> {log}\necho '{{\"outputs\": []}}' > \"$report\"\n",
+        log = log.display()
+    );
+    std::fs::write(&exe, script).unwrap();
+    std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
+    exe
+}
+
+#[test]
+fn a_cancelled_request_stops_its_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = Config {
+        exe: fake_runner(dir.path()),
+        time_limit: Duration::from_secs(60),
+        ..config(&dir.path().join("out"))
+    };
+    let src = "prompt \"a person waves\"\nlength 1s\nat end { r_hand.y > head.y }\n";
+    let mut input = HANDSHAKE.to_string();
+    for line in [
+        call(
+            1,
+            "run",
+            json!({"source": src, "seed": 1, "output": "slow.json"}),
+        ),
+        json!({"jsonrpc": "2.0", "method": "notifications/cancelled",
+               "params": {"requestId": 1, "reason": "the user changed their mind"}})
+        .to_string(),
+        // Runs take turns: this one can only finish soon if the first one was stopped.
+        call(
+            2,
+            "run",
+            json!({"source": src, "seed": 2, "output": "fast.json"}),
+        ),
+    ] {
+        input.push_str(&line);
+        input.push('\n');
+    }
+    let started = std::time::Instant::now();
+    let r = exchange(
+        server(&config).unwrap(),
+        input.into_bytes(),
+        |got| got.iter().any(|m| m["id"] == 2),
+        Duration::from_secs(60),
+    )
+    .unwrap();
+    let second = &by_id(&r, 2)["result"];
+    assert_eq!(second["isError"], false, "{second}");
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "{:?}",
+        started.elapsed()
+    );
+    // The first run started and never ended; the second ran to its end.
+    let log = std::fs::read_to_string(dir.path().join("log")).unwrap_or_default();
+    assert!(
+        log == "start\nstart\nend\n" || log == "start\nend\n",
+        "{log:?}"
+    );
+}
