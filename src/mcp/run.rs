@@ -1,7 +1,8 @@
 //! The `run` tool: generation steered by a program, in a child `mprog run` process. A
 //! child can be stopped at any point (a cancelled request or the time limit kill it; its
-//! outputs are written atomically, so nothing half-written is left), and the server stays
-//! small and responsive while it works. Runs take the one lock: others queue.
+//! outputs are written atomically, so no half-written file is left under an output's
+//! name, at most a `.mprog-*.tmp` beside it), and the server stays small and responsive
+//! while it works. Runs take the one lock: others queue.
 
 use super::args::RunArgs;
 use super::calls::SOURCE_NAME;
