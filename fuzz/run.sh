@@ -8,7 +8,7 @@ cd "$(dirname "$0")"
 seconds="${1:-300}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(mprog_check bvh npy json asf)
+[ ${#targets[@]} -eq 0 ] && targets=(mprog_check bvh npy json asf mcp)
 root=..
 
 seed() { # target, files…
@@ -29,12 +29,13 @@ seed npy "$root"/tests/fixtures/humanml3d/Mean.npy "$root"/tests/fixtures/advers
     "$root"/tests/fixtures/fuzz/npy/*
 seed json "$root"/tests/fixtures/adversarial/*.json "$root"/tests/fixtures/fuzz/json/*
 seed mprog_check "$root"/tests/fixtures/fuzz/mprog_check/*
+seed mcp "$root"/tests/fixtures/fuzz/mcp/*
 
 export RUSTC_BOOTSTRAP=1
 for t in "${targets[@]}"; do
     mkdir -p "artifacts/$t"
     # Deep inputs need room: 8 kB for BVH/JSON (a whole small rig), 4 kB otherwise.
-    case "$t" in bvh | json | asf) len=8192 ;; *) len=4096 ;; esac
+    case "$t" in bvh | json | asf | mcp) len=8192 ;; *) len=4096 ;; esac
     cargo fuzz run -O -a -s none "$t" "corpus/$t" -- \
         -workers=1 -max_total_time="$seconds" -max_len="$len" \
         -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \

@@ -13,6 +13,7 @@ pub mod formats;
 pub mod fsutil;
 pub mod interrupt;
 pub mod lang;
+pub mod mcp;
 pub mod metrics;
 pub mod model;
 pub mod motion;

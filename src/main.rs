@@ -39,6 +39,9 @@ enum Command {
     Run(cli::run::RunArgs),
     /// A program's error on a motion file, per statement, with an optional plot over time.
     Score(cli::score::ScoreArgs),
+    /// Serve the Model Context Protocol on stdin/stdout: tools check, score, run, joints
+    /// and library, and the prompt card, for LLM agents.
+    Mcp(cli::mcp::McpArgs),
     /// Check `.mprog` programs and print their diagnostics.
     Check(cli::check::CheckArgs),
     /// Evaluate a model against real test clips (metrics, FID, R-precision), or train
@@ -107,6 +110,7 @@ fn main() -> miette::Result<()> {
             }
         }
         Command::Eval(args) => cli::eval::run(args)?,
+        Command::Mcp(args) => cli::mcp::run(args)?,
     }
     Ok(())
 }

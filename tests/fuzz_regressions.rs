@@ -78,14 +78,22 @@ fn json(data: &[u8]) {
     }
 }
 
+/// `fuzz_targets/mcp.rs`: JSON-RPC lines to the MCP server after its handshake.
+fn mcp(data: &[u8]) {
+    if let Err(e) = mprog::mcp::fuzz_one(data) {
+        panic!("{e}");
+    }
+}
+
 /// A fuzz target's body.
 type Target = fn(&[u8]);
 
-const TARGETS: [(&str, Target); 4] = [
+const TARGETS: [(&str, Target); 5] = [
     ("mprog_check", mprog_check),
     ("bvh", bvh),
     ("npy", npy),
     ("json", json),
+    ("mcp", mcp),
 ];
 
 fn files(dir: &Path) -> Vec<PathBuf> {

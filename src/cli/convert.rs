@@ -43,7 +43,7 @@ pub struct RenderArgs {
 pub fn convert(args: ConvertArgs) -> Result<()> {
     let (people, meta) = load_input(&args.input, args.asf.as_deref())?;
     let title = args.input.display().to_string();
-    write_outputs_with(&args.out, &people, &meta, &title, &args.export)
+    write_outputs_with(&args.out, &people, &meta, &title, &args.export).map(|_| ())
 }
 
 /// Runs `mprog render`.

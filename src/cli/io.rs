@@ -36,7 +36,7 @@ pub fn write_outputs(
     meta: &Meta,
     title: &str,
 ) -> Result<()> {
-    write_outputs_with(outputs, people, meta, title, &ExportArgs::default())
+    write_outputs_with(outputs, people, meta, title, &ExportArgs::default()).map(|_| ())
 }
 
 /// Writes every requested output through the table of output kinds; pictures and pages
@@ -47,7 +47,7 @@ pub fn write_outputs_with(
     meta: &Meta,
     title: &str,
     export: &ExportArgs,
-) -> Result<()> {
+) -> Result<Vec<PathBuf>> {
     export.check_against(outputs)?;
     let job = OutputJob {
         people,
@@ -55,10 +55,11 @@ pub fn write_outputs_with(
         title,
         bvh: &export.bvh_options(),
     };
-    for path in formats::write_outputs(outputs, &job).into_diagnostic()? {
+    let written = formats::write_outputs(outputs, &job).into_diagnostic()?;
+    for path in &written {
         eprintln!("wrote {}", path.display());
     }
-    Ok(())
+    Ok(written)
 }
 
 /// Whether every output is of a kind mprog writes, judged by its extension (before any

@@ -11,6 +11,7 @@ pub mod eval;
 pub mod export;
 pub mod generate;
 pub mod io;
+pub mod mcp;
 pub mod repl;
 pub mod run;
 pub mod score;

@@ -61,6 +61,10 @@ pub struct RunArgs {
     /// Model bundle folder (default: models/default).
     #[arg(long)]
     model: Option<PathBuf>,
+    /// Also write the per-statement errors (next to the unguided ones), the times and the
+    /// files written as JSON, for tools (`mprog mcp` reads it).
+    #[arg(long)]
+    report: Option<PathBuf>,
     /// Outputs; each one's extension picks its kind (`--help` lists them).
     #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
@@ -266,11 +270,41 @@ pub fn run(args: RunArgs) -> Result<()> {
     );
     meta.insert("prompts".into(), serde_json::json!(prompts));
     meta.extend(mprog::view::program::program_meta(&program, people, &device).into_diagnostic()?);
-    write_outputs_with(
+    let written = write_outputs_with(
         &args.out,
         people,
         &meta,
         &format!("{} ({})", program.name(), solver.name()),
         &args.export,
-    )
+    )?;
+    if let Some(path) = &args.report {
+        let statements: Vec<serde_json::Value> = program
+            .statements()
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                serde_json::json!({
+                    "line": s.line,
+                    "statement": s.label.split_once(": ").map_or(s.label.as_str(), |(_, t)| t).trim(),
+                    "unit": s.unit,
+                    "unguided": baseline.as_ref().map(|(b, _)| b[i]),
+                    "guided": guided[i],
+                })
+            })
+            .collect();
+        let report = serde_json::json!({
+            "solver": solver.name(),
+            "seed": args.seed,
+            "statements": statements,
+            "total": {"guided": total, "unguided": baseline.as_ref().map(|(b, _)| b.iter().sum::<f32>())},
+            "seconds": {"guided": result.seconds, "unguided": baseline.as_ref().map(|(_, s)| *s)},
+            "body": body_summary(people),
+            "outputs": written,
+        });
+        let text = serde_json::to_string_pretty(&report).into_diagnostic()?;
+        mprog::fsutil::write_bytes_atomic(path, text.as_bytes())
+            .into_diagnostic()
+            .wrap_err_with(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
 }

@@ -45,13 +45,15 @@ always weight 0.5 { speed(pelvis) < 0.3 }
 "#,
     ),
     (
-        "Sit down on a chair whose seat is 45 cm high, 50 cm behind the starting position.",
+        "Sit down on a chair whose seat surface is 45 cm high, 50 cm behind the starting position.",
         r#"prompt "a person sits down on a chair"
 length 5s
-param seat = 45 cm
+param seat = 45 cm                 # height of the seat surface
+# The pelvis joint is inside the body, about 10 cm above what the person sits on.
+let sitting = seat + 10 cm
 
 at 80%, end {
-    abs(pelvis.y - seat - 10 cm) < 5 cm
+    abs(pelvis.y - sitting) < 5 cm
     groundDist(pelvis, [0, 0, -0.5]) < 10 cm
 }
 always { footHeight(me) < 5 cm }
@@ -111,7 +113,12 @@ Joints are points inside the body, not its surface:
   in front. A ceiling at height h needs `head.y < h - 12 cm`.
 - `l_hand`/`r_hand` are the **wrists**; the palm is about 8 cm and the fingertips about
   18 cm further along the forearm. "Hand on the floor" is about `r_hand.y < 10 cm`;
-  "hand touching a surface" is about `distToPlane(r_hand, …) < 8 cm`.
+  "hand touching a surface" is about `distToPlane(r_hand, …) < 8 cm`. `distToPlane` is
+  **unsigned**, so that lets the hand go through the wall to the other side; when the
+  surface is solid (a wall, a table top), keep the hand on its side with
+  `signedDistToPlane(r_hand, point, normal)`, positive on the side the normal points to:
+  `signedDistToPlane(r_hand, [0, 0, 1], [0, 0, -1]) > 0` and `… < 8 cm` for a wall at
+  z = 1 m faced from the start.
 - `l_foot`/`r_foot` are the balls of the feet (toe joints), `l_ankle`/`r_ankle` the
   ankles. A planted foot has its toe joint below 5 cm and its ankle below 10 cm;
   `footHeight(me)` is the lowest of the four.
@@ -202,15 +209,18 @@ with one complete program in a ```mprog code block, and nothing the language lac
   its centre (0, 0, r), r = 1 / sin(180°/P) (1.15 m for three): the first at the origin
   facing +Z, the next ones going round to the first one's right (−X side), so with three
   people `b` stands front-right of `a` and `c` front-left. `spacing 1 m` (a header
-  line, 0.4–20 m) puts neighbours that far apart instead: use it when people touch from
-  the start (holding hands: about 1 m), else they must walk to each other first.
+  line, 0.4–20 m) puts neighbours that far apart instead: with two people `b` then stands
+  at (0, 0, 1), still facing `a` (−Z). Use it when people touch from the start (holding
+  hands: about 1 m), else they must walk to each other first.
 - The person is about 1.6 m tall: pelvis ≈ 0.92 m, head joint ≈ 1.48 m when standing
   (table below). Arms are about 0.6 m long (shoulder to wrist), legs about 0.85 m.
   Across the body: hips ±0.06–0.1 m from the pelvis in x, feet ±0.1–0.25 m (by stance),
   shoulders ±0.2 m.
 - Speeds: walking ≈ 1.3 m/s (0.07 m per frame), running ≈ 3 m/s (0.15 m per frame); a
   constraint on a thin region (a hurdle, a line) should be thicker than one frame's
-  travel, or a fast joint can step over it between frames.
+  travel, or a fast joint can step over it between frames. There is no `m/s` unit:
+  `vel(p)` (a vector) and `speed(p)` (a number) are in m/s, and a bare number compared
+  with them is in m/s too: `speed(pelvis) < 1.5` means 1.5 m/s.
 
 ## The language in brief
 
@@ -225,6 +235,7 @@ always { near(l_hand, r_hand, d) }     # every frame (top-level statements are `
 at start, end { head.y > 1.5 m }       # keyframes
 during 2s..4s { pelvis.z > 1 m }       # frames 2 s ≤ t < 4 s
 for f in [l_foot, r_foot] { at end { f.y < 5 cm } }
+for j in joints { j.y < 2.2 m }        # all 22 joints (`joints` is the set of them)
 if head.z > 2 m and head.z < 3 m { head.y < 1.2 m } else { head.y > 1.4 m }
 weight 2 { speed(pelvis) < 1.5 }       # multiply errors by a constant ≥ 0
 minimize norm(acc(r_hand))             # any scalar
@@ -257,8 +268,9 @@ minimize norm(acc(r_hand))             # any scalar
   else weight minimize maximize and or not x y z xz me joints people start mid end true
   false`.
 - Functions may take people: `def hold(p, q) = dist(p.r_hand, q.l_hand) < 10 cm`;
-  `for p in people { … }` loops over every person and `for j in [head, neck]` or
-  `for h in hands` over joints.
+  `for p in people { … }` loops over every person and `for j in [head, neck]`,
+  `for h in hands` or `for j in joints` (all 22) over joints. With several people a joint
+  of the set needs its person: `for p in people { for j in joints { p.j.y > -5 cm } }`.
 - Several people: `people a "prompt of a", b "prompt of b"` replaces `prompt`; joints are
   then qualified (`a.r_hand`, `b.head`) and functions taking a person get `a`/`b`. With
   one person the person is called `me`.
@@ -276,6 +288,14 @@ const SEMANTICS: &str = r#"
 | `c1 or c2` | min(E1, E2) |
 | `not c` | −E |
 | `minimize e` / `maximize e` | e / −e |
+
+Some functions take **people**, the others **points** (joints, vectors):
+
+| takes | functions |
+| --- | --- |
+| a person (`me`, `a`, a `for p in people` variable) | `balanced(p)`, `footHeight(p)`; `facing(p?)`, `massCtr(p?)`, `massCtrNoHead(p?)` (with one person the argument may be left out: `facing()`; `balanced` and `footHeight` always need it: `balanced(me)`) |
+| two people | `separation(p, q, d)` (their pelvises on the ground), `faceToFace(p, q)`, `noTorsoCollision(p, q, r)` |
+| points | `contact(p, q, d)` and `apart(p, q, d)` (two joints, e.g. `a.r_hand, b.r_hand`), `dist`, `groundDist`, `distToPlane`, `signedDistToPlane`, `vel`, `speed`, `inBox`, `inSquare`, … |
 
 Library functions marked **constraint** in the list above (`inBox`, `inSquare`, `boneDir`,
 `balanced`, `contact`, `apart`, `separation`, `faceToFace`, `noTorsoCollision`) are
@@ -302,15 +322,18 @@ const RULES: &str = r#"
    "below the bar" is `head.y < bar`. Read each comparison back as a sentence.
 4. Every constraint must involve the motion (a joint, `massCtr()`, `facing()`, …): a
    comparison of constants has no effect and is reported. So is a constraint no motion
-   can meet (`mprog::never_met`: a place other than the start at frame 0, a joint 4 m up,
-   20 m travelled in a second).
+   can meet (`mprog::never_met`: a place other than the start at frame 0, which `always`
+   and `during 0s..…` include, a joint 4 m up, 20 m travelled in a second).
 5. Keyframes must lie inside the length: with `length 4s`, `at 5s` is an error; prefer
    `start`, `mid`, `end` and percentages.
 6. Give a `length` (at most 9.8 s) and a `prompt` that describes the whole motion; the
    constraints only steer it.
 7. Prefer tolerances to exact equalities for positions (`dist(p, q) < 5 cm`), and keep
    targets reachable: arms are about 0.6 m long, a step is about 0.7 m, walking speed is
-   about 1.3 m/s.
+   about 1.3 m/s. A hand target farther than that from where the person stands needs a
+   step: say where the pelvis goes (`mprog::out_of_reach` warns otherwise), and leave time
+   between two places of one joint (`mprog::frame_jump` warns of a jump, e.g. 24 cm
+   between consecutive frames).
 8. Units must agree: do not compare a distance with a time or an angle.
 9. The error is pushed just to the threshold, not past it: when a limit must really hold
    (a wall, a ceiling, a radius), leave a few centimetres of margin in the number.
@@ -338,6 +361,32 @@ mod tests {
             let real = (height(j) + height(mirror)) / 2.0;
             assert!((real - h).abs() < 0.011, "joint {j}: {h} vs {real}");
         }
+    }
+
+    #[test]
+    fn card_snippets_compile_as_the_card_says() {
+        // Every worked example checks without warnings (the trial's programs did too).
+        for (task, program) in EXAMPLES {
+            let d = crate::lang::check_source(program, "example.mprog", &[]);
+            assert!(d.items.is_empty(), "{task}\n{}", d.render_plain());
+        }
+        for src in [
+            "length 2s\npeople a \"x\", b \"y\"\nfor p in people { for j in joints { p.j.y > -5 cm } }\n",
+            "length 2s\nspeed(pelvis) < 1.5\nalways { balanced(me) }\nat end { dot(facing(), [0, 0, 1]) > 0.9 }\n",
+            "length 2s\nat end { signedDistToPlane(r_hand, [0, 0, 1], [0, 0, -1]) > 0 and signedDistToPlane(r_hand, [0, 0, 1], [0, 0, -1]) < 8 cm }\n",
+        ] {
+            let d = crate::lang::check_source(src, "t.mprog", &[]);
+            assert!(!d.has_errors(), "{src}\n{}", d.render_plain());
+        }
+        // Two people `spacing 1 m` apart: `b` starts at (0, 0, 1).
+        let p = crate::lang::compile(
+            "length 2s\nspacing 1 m\npeople a \"x\", b \"y\"\nat end { separation(a, b, 0.5 m) }\n",
+            "t.mprog",
+            &[],
+        )
+        .unwrap();
+        let b = p.placements()[1];
+        assert!((b.x.abs(), (b.z - 1.0).abs()) < (1e-6, 1e-6), "{b:?}");
     }
 
     #[test]

@@ -1,261 +1,156 @@
 //! Constraints no motion can meet, found before anything runs by interval arithmetic
-//! over the IR.
+//! over the IR (`bounds.rs`).
 //!
-//! Every joint coordinate a statement reads is bounded: heights by what a human body
-//! reaches, ground positions by where the person starts (the solvers pin each person's
-//! pelvis at frame 0 to its start placement) plus how far a body reaches from its pelvis
-//! and how far a person can run by that frame. Propagating those intervals through the
-//! statement's ops bounds its error from below; a constraint whose error is bounded away
-//! from zero on every frame it applies to can never be met (`at start { pelvis.x > 1 m }`,
-//! `head.y > 3 m`, `at 1s { pelvis.z > 20 m }`). The bounds are generous, so a warning is
-//! certain; many impossible constraints (limb lengths between two joints) go unnoticed.
+//! Propagating the joints' bounds through a statement's ops bounds its error from below;
+//! a constraint whose error is bounded away from zero on every frame it applies to can
+//! never be met (`at start { pelvis.x > 1 m }`, `head.y > 3 m`, `at 1s { pelvis.z > 20 m }`).
+//! The bounds are generous, so a warning is certain; many impossible constraints (limb
+//! lengths between two joints) go unnoticed. Each warning names its cause: the statement
+//! is checked again with one assumption dropped, and the first one whose removal makes it
+//! possible is the cause.
 
-use crate::lang::ir::{BinaryOp, Ir, NodeId, Op, UnaryOp};
+use super::bounds::{Limits, Pass, Pick, TOLERANCE, cone, lowest};
+use crate::lang::ir::{Ir, Statement};
 use crate::scene::Placement;
 
-/// Ground distance a joint other than the pelvis reaches from the pelvis (m).
-const REACH: f64 = 1.4;
-/// Slack on the pinned pelvis position at frame 0 (m).
-const PINNED: f64 = 0.02;
-/// Fastest horizontal travel (m per frame at 20 fps: 10 m/s).
-const TRAVEL_PER_FRAME: f64 = 0.5;
-/// Heights any joint can take (m): a little under the floor to a jump with arms up.
-const HEIGHT: (f64, f64) = (-0.3, 3.0);
-/// Errors below this are "met" (the smooth norms leave ~1e-6).
-const TOLERANCE: f64 = 1e-3;
+/// Why a constraint can never be met: the assumption that rules it out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cause {
+    /// The pelvis is pinned to the start place at frame 0, and the constraint applies
+    /// there: only on frame 0 (`at start`).
+    AtStart,
+    /// As [`Cause::AtStart`], but the constraint covers frame 0 and more (`always`,
+    /// `during 0s..…`): frame 0 alone makes it impossible.
+    IncludesStart,
+    /// A height outside what a body reaches (-0.3 to 3 m).
+    Height,
+    /// Farther from the start than a person can run by then (10 m/s).
+    Travel,
+    /// None of those alone.
+    Other,
+}
 
+/// A constraint no motion can meet.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Iv {
-    lo: f64,
-    hi: f64,
+pub struct NeverMet {
+    /// Index in [`Ir::statements`].
+    pub statement: usize,
+    /// Lowest possible value of its error.
+    pub lowest: f64,
+    /// What rules it out.
+    pub cause: Cause,
+    /// The last frame it applies to (for [`Cause::Travel`]'s message).
+    pub last_frame: usize,
 }
 
-impl Iv {
-    const ANY: Iv = Iv {
-        lo: f64::NEG_INFINITY,
-        hi: f64::INFINITY,
-    };
-
-    fn new(lo: f64, hi: f64) -> Iv {
-        if lo.is_nan() || hi.is_nan() {
-            Iv::ANY
-        } else {
-            Iv { lo, hi }
-        }
-    }
-
-    fn point(x: f64) -> Iv {
-        Iv::new(x, x)
-    }
-
-    fn union(self, o: Iv) -> Iv {
-        Iv::new(self.lo.min(o.lo), self.hi.max(o.hi))
-    }
-
-    fn add(self, o: Iv) -> Iv {
-        Iv::new(self.lo + o.lo, self.hi + o.hi)
-    }
-
-    fn neg(self) -> Iv {
-        Iv::new(-self.hi, -self.lo)
-    }
-
-    fn mul(self, o: Iv) -> Iv {
-        let p = [
-            self.lo * o.lo,
-            self.lo * o.hi,
-            self.hi * o.lo,
-            self.hi * o.hi,
-        ];
-        // 0 · ∞ is NaN: an infinite bound times zero stays unbounded.
-        if p.iter().any(|x| x.is_nan()) {
-            return Iv::ANY;
-        }
-        Iv::new(
-            p.iter().copied().fold(f64::INFINITY, f64::min),
-            p.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        )
-    }
-
-    fn div(self, o: Iv) -> Iv {
-        if o.lo <= 0.0 && o.hi >= 0.0 {
-            return Iv::ANY;
-        }
-        self.mul(Iv::new(1.0 / o.hi, 1.0 / o.lo))
-    }
-
-    fn abs(self) -> Iv {
-        if self.lo >= 0.0 {
-            self
-        } else if self.hi <= 0.0 {
-            self.neg()
-        } else {
-            Iv::new(0.0, self.hi.max(-self.lo))
-        }
-    }
-
-    fn square(self) -> Iv {
-        let a = self.abs();
-        Iv::new(a.lo * a.lo, a.hi * a.hi)
-    }
-
-    fn relu(self) -> Iv {
-        Iv::new(self.lo.max(0.0), self.hi.max(0.0))
-    }
-
-    fn sqrt(self) -> Iv {
-        let r = self.relu();
-        Iv::new((r.lo + 1e-12).sqrt(), (r.hi + 1e-12).sqrt())
-    }
-}
-
-/// Per-channel bounds of one node, over all its frames and lanes.
-type Bounds = Vec<Iv>;
-
-fn broadcast(v: &Bounds, c: usize) -> Iv {
-    if v.len() == 1 { v[0] } else { v[c] }
-}
-
-fn binary(op: BinaryOp, a: &Bounds, b: &Bounds) -> Bounds {
-    let n = a.len().max(b.len());
-    (0..n)
-        .map(|c| {
-            let (x, y) = (broadcast(a, c), broadcast(b, c));
-            match op {
-                BinaryOp::Add => x.add(y),
-                BinaryOp::Sub => x.add(y.neg()),
-                BinaryOp::Mul => x.mul(y),
-                BinaryOp::Div => x.div(y),
-                BinaryOp::Min => Iv::new(x.lo.min(y.lo), x.hi.min(y.hi)),
-                BinaryOp::Max => Iv::new(x.lo.max(y.lo), x.hi.max(y.hi)),
-                BinaryOp::Atan2 => Iv::new(-std::f64::consts::PI, std::f64::consts::PI),
-            }
-        })
-        .collect()
-}
-
-fn unary(op: UnaryOp, a: &Bounds) -> Bounds {
-    a.iter()
-        .map(|&x| match op {
-            UnaryOp::Neg => x.neg(),
-            UnaryOp::Abs => x.abs(),
-            UnaryOp::Sqrt => x.sqrt(),
-            UnaryOp::Relu => x.relu(),
-            UnaryOp::Sin | UnaryOp::Cos => Iv::new(-1.0, 1.0),
-            UnaryOp::Square => x.square(),
-            UnaryOp::OneMinus => Iv::point(1.0).add(x.neg()),
-        })
-        .collect()
-}
-
-/// Where the joints of `points` can be on the frames of a domain whose last frame is
-/// `last` (None: the domain is empty).
-fn joint_bounds(points: &[(usize, usize)], last: usize, starts: &[Placement]) -> Bounds {
-    let travel = TRAVEL_PER_FRAME * last as f64;
-    let mut out: Option<Bounds> = None;
-    for &(person, joint) in points {
-        let start = starts.get(person).copied().unwrap_or(Placement::IDENTITY);
-        let r = travel + if joint == 0 { PINNED } else { REACH };
-        let b = vec![
-            Iv::new(f64::from(start.x) - r, f64::from(start.x) + r),
-            Iv::new(HEIGHT.0, HEIGHT.1),
-            Iv::new(f64::from(start.z) - r, f64::from(start.z) + r),
-        ];
-        out = Some(match out {
-            None => b,
-            Some(o) => o.iter().zip(&b).map(|(x, y)| x.union(*y)).collect(),
-        });
-    }
-    out.unwrap_or_else(|| vec![Iv::ANY; 3])
-}
-
-/// Which frame of each joint read's domain the bounds are for.
-#[derive(Clone, Copy, PartialEq)]
-enum Pick {
-    /// The latest: bounds that hold on every frame.
-    Latest,
-    /// The earliest: bounds on the first frame each statement applies to.
-    Earliest,
-}
-
-/// Bounds of every node of `ir`.
-fn node_bounds(ir: &Ir, starts: &[Placement], pick: Pick) -> Vec<Bounds> {
-    let mut out: Vec<Bounds> = Vec::with_capacity(ir.nodes.len());
-    let last_frame = |d| {
-        let frames = ir.resolve_domain(d, ir.length).into_iter();
-        match pick {
-            Pick::Latest => frames.max(),
-            Pick::Earliest => frames.min(),
-        }
-        .unwrap_or(ir.length.saturating_sub(1))
-    };
-    for node in &ir.nodes {
-        let get = |i: NodeId| &out[i];
-        let b: Bounds = match &node.op {
-            Op::Const(v) => v.iter().map(|&x| Iv::point(f64::from(x))).collect(),
-            Op::Gather { domain, points } => joint_bounds(points, last_frame(*domain), starts),
-            Op::MassCenter {
-                domain, persons, ..
-            } => {
-                let points: Vec<(usize, usize)> = persons.iter().map(|&p| (p, 1)).collect();
-                joint_bounds(&points, last_frame(*domain), starts)
-            }
-            Op::Component { arg, axis } => vec![broadcast(get(*arg), *axis)],
-            Op::Compose(a) => a.iter().map(|&i| broadcast(get(i), 0)).collect(),
-            Op::Unary { op, arg } => unary(*op, get(*arg)),
-            Op::Binary { op, a, b } => binary(*op, get(*a), get(*b)),
-            Op::SumChannels(a) => vec![get(*a).iter().fold(Iv::point(0.0), |s, x| s.add(*x))],
-            Op::Norm(a) => {
-                let s = get(*a)
-                    .iter()
-                    .fold(Iv::point(0.0), |s, x| s.add(x.square()));
-                vec![s.sqrt()]
-            }
-            Op::Cross(a, b) => {
-                let (a, b) = (get(*a), get(*b));
-                let c = |i: usize| broadcast(a, i);
-                let d = |i: usize| broadcast(b, i);
-                vec![
-                    c(1).mul(d(2)).add(c(2).mul(d(1)).neg()),
-                    c(2).mul(d(0)).add(c(0).mul(d(2)).neg()),
-                    c(0).mul(d(1)).add(c(1).mul(d(0)).neg()),
-                ]
-            }
-            Op::Relabel(a) => get(*a).clone(),
-            Op::SupportDist { .. } => vec![Iv::ANY],
-            Op::Less { .. } => vec![Iv::new(0.0, 1.0); node.channels.max(1)],
-        };
-        out.push(b);
-    }
-    out
-}
-
-/// `(statement index, lowest possible error)` of every constraint no motion can meet.
-/// Objectives (`minimize`), statements under an `if` and weight-0 statements are skipped.
+/// The lowest error `s` can have under `limits`, when that is above the tolerance.
 ///
 /// A statement's error is the mean over its frames. With bounds valid on every frame, a
 /// positive lower bound is the answer. Joints read on the statement's earliest frame are
 /// bounded tighter (less time to travel); when the error can never be negative, a positive
 /// bound on that one frame alone makes the mean positive too.
-pub fn never_met(ir: &Ir) -> Vec<(usize, f64)> {
+fn lowest_error(ir: &Ir, s: &Statement, starts: &[Placement], limits: Limits) -> Option<f64> {
+    let ids = cone(ir, s);
+    let error_of = |pick| {
+        let pass = Pass {
+            starts,
+            limits,
+            pick,
+            fixed: &[],
+        };
+        lowest(pass.run(ir, &ids).last().expect("a cone holds its error"))
+    };
+    let anywhere = error_of(Pick::Latest);
+    if anywhere.is_finite() && anywhere > TOLERANCE {
+        return Some(anywhere);
+    }
+    let frames = ir.resolve_domain(s.domain, ir.length).len().max(1);
+    let mean = error_of(Pick::Earliest) / frames as f64;
+    (anywhere >= 0.0 && mean.is_finite() && mean > TOLERANCE).then_some(mean)
+}
+
+/// Every constraint no motion can meet, with its cause. Objectives (`minimize`),
+/// statements under an `if` and weight-0 statements are skipped.
+pub fn never_met(ir: &Ir) -> Vec<NeverMet> {
     let starts = ir.start_placements();
-    let every = node_bounds(ir, &starts, Pick::Latest);
-    let first = node_bounds(ir, &starts, Pick::Earliest);
-    let lowest = |b: &Bounds| b.iter().map(|x| x.lo).fold(f64::INFINITY, f64::min);
+    let body = Limits::BODY;
     ir.statements
         .iter()
         .enumerate()
         .filter(|(_, s)| s.mask.is_none() && s.weight > 0.0 && !s.objective)
         .filter_map(|(i, s)| {
-            let anywhere = lowest(&every[s.error]);
-            if anywhere.is_finite() && anywhere > TOLERANCE {
-                return Some((i, anywhere));
-            }
-            let frames = ir.resolve_domain(s.domain, ir.length).len().max(1);
-            let mean = lowest(&first[s.error]) / frames as f64;
-            (anywhere >= 0.0 && mean.is_finite() && mean > TOLERANCE).then_some((i, mean))
+            let lowest = lowest_error(ir, s, &starts, body)?;
+            let frames = ir.resolve_domain(s.domain, ir.length);
+            let possible = |limits| lowest_error(ir, s, &starts, limits).is_none();
+            let cause = if frames.contains(&0)
+                && possible(Limits {
+                    pinned: body.reach,
+                    ..body
+                }) {
+                if frames.len() == 1 {
+                    Cause::AtStart
+                } else {
+                    Cause::IncludesStart
+                }
+            } else if possible(Limits {
+                height: (f64::NEG_INFINITY, f64::INFINITY),
+                ..body
+            }) {
+                Cause::Height
+            } else if possible(Limits {
+                travel_per_frame: f64::INFINITY,
+                ..body
+            }) {
+                Cause::Travel
+            } else {
+                Cause::Other
+            };
+            Some(NeverMet {
+                statement: i,
+                lowest,
+                cause,
+                last_frame: frames.iter().copied().max().unwrap_or(0),
+            })
         })
         .collect()
+}
+
+/// The hint of a `mprog::never_met` warning: what to change, for its cause.
+pub fn hint(cause: Cause, last_frame: usize) -> String {
+    const UNITS: &str =
+        "A number without a unit is in metres: `head.y + 15` is 15 m higher; write `15 cm`";
+    match cause {
+        Cause::AtStart => {
+            "at frame 0 each person's pelvis is pinned to its start place (x = z = 0 \
+             with one person; see `spacing` for two or more), so a ground position at `start` \
+             can only restate it. Put the constraint at a later time (`at 1s`, `at end`), or \
+             write places relative to the start (`pelvis@start + [0, 0, 3]`)"
+                .to_string()
+        }
+        Cause::IncludesStart => "this block includes frame 0, where each person's pelvis is \
+             still pinned to its start place (x = z = 0 with one person): frame 0 alone \
+             breaks it. Start the block later (`during 1s..end` instead of `always`), ask \
+             only at the end (`at end`), or write places relative to the start \
+             (`pelvis@start + [0.5, 0, 0]`)"
+            .to_string(),
+        Cause::Height => format!(
+            "heights (`.y`, up) lie between -0.3 and 3 m. Check the axis (`.y` is up, `.z` \
+             ahead, `.x` to the left) and the direction of the comparison. {UNITS}"
+        ),
+        Cause::Travel => format!(
+            "a person moves at most about 10 m/s, so by frame {last_frame} ({:.2} s) every \
+             joint is within {:.1} m of its start place. Make the motion longer, the distance \
+             shorter, or the time later. {UNITS}",
+            last_frame as f64 / 20.0,
+            Limits::BODY.travel_per_frame * last_frame as f64 + Limits::BODY.reach
+        ),
+        Cause::Other => format!(
+            "heights (`.y`, up) lie between -0.3 and 3 m; each person's pelvis starts at its \
+             start place (x = z = 0 with one person) and moves at most about 10 m/s. Check \
+             the axis and the direction of the comparison, and write places relative to the \
+             start (`pelvis@start + [0, 0, 3]`). {UNITS}"
+        ),
+    }
 }
 
 #[cfg(test)]
@@ -268,6 +163,26 @@ mod tests {
         d.warnings()
             .filter(|w| w.code == "mprog::never_met")
             .count()
+    }
+
+    #[test]
+    fn each_cause_is_named() {
+        use super::{Cause, never_met};
+        for (body, cause) in [
+            ("at start { pelvis.x > 1 m }", Cause::AtStart),
+            (
+                "always { abs(pelvis.x - 0.5 m) < 5 cm }",
+                Cause::IncludesStart,
+            ),
+            ("head.y > 3.5 m", Cause::Height),
+            ("l_foot.y < -1 m", Cause::Height),
+            ("at 1s { pelvis.z > 20 m }", Cause::Travel),
+        ] {
+            let p = crate::lang::compile(&format!("length 4s\n{body}\n"), "t.mprog", &[]).unwrap();
+            let found = never_met(p.ir());
+            assert_eq!(found.len(), 1, "{body}");
+            assert_eq!(found[0].cause, cause, "{body}");
+        }
     }
 
     #[test]

@@ -12,7 +12,11 @@
 //! | `calls.rs` | builtin and user function calls |
 //! | `time.rs` | time positions (`2s`, `50%`, `end - 1`) |
 //! | `builder.rs` | IR nodes: shapes, sharing, constant folding |
+//! | `advice.rs` | warnings on the IR: impossible, out-of-reach and jumping constraints |
+//! | `bounds.rs`, `feasibility.rs`, `reach.rs` | the interval analysis behind them |
 
+mod advice;
+mod bounds;
 mod builder;
 pub mod builtins;
 mod calls;
@@ -21,6 +25,7 @@ pub mod feasibility;
 mod geometry;
 mod header;
 mod ops;
+pub mod reach;
 mod stmt;
 mod time;
 pub mod units;
@@ -220,6 +225,7 @@ pub fn module_to_ir<'a>(
     };
     c.load_library(library);
     c.header_items(module, overrides);
+    let header_ok = !c.diags.iter().any(|d| d.severity == Severity::Error);
     c.body(module);
     if c.b.overflow {
         c.diags.push(
@@ -249,6 +255,14 @@ pub fn module_to_ir<'a>(
         );
     }
     if c.diags.iter().any(|d| d.severity == Severity::Error) {
+        // The statements that checked cleanly still get the IR warnings (`body` keeps
+        // only those), so one repair round sees every problem.
+        if header_ok && !c.b.overflow && !c.statements.is_empty() {
+            let ir = c.finish();
+            if within_limits(&ir) {
+                c.diags.extend(advice::warnings(&ir));
+            }
+        }
         return (None, c.diags);
     }
     let ir = c.finish();
@@ -288,27 +302,7 @@ pub fn module_to_ir<'a>(
         );
         return (None, c.diags);
     }
-    for (i, lowest) in feasibility::never_met(&ir) {
-        let s = &ir.statements[i];
-        c.diags.push(
-            Diagnostic::warning(
-                "mprog::never_met",
-                s.span,
-                format!(
-                    "no motion can meet this constraint: its error is at least {lowest:.3} {}",
-                    s.unit
-                ),
-            )
-            .label("impossible")
-            .help(
-                "heights (`.y`, up) lie between -0.3 and 3 m; each person's pelvis starts at its \
-                 start place (x = z = 0 with one person) and moves at most about 10 m/s. Check \
-                 the axis and the direction of the comparison, and write places relative to the \
-                 start (`pelvis@start + [0, 0, 3]`). A number without a unit is in metres: \
-                 `head.y + 15` is 15 m higher; write `15 cm`",
-            ),
-        );
-    }
+    c.diags.extend(advice::warnings(&ir));
     let header = c.header.clone();
     let overlays = std::mem::take(&mut c.overlays);
     let contacts = c
@@ -334,6 +328,17 @@ pub fn module_to_ir<'a>(
         }),
         c.diags,
     )
+}
+
+/// Whether an IR from a program with errors is safe to analyse: finite constants and a
+/// cost under the limits.
+fn within_limits(ir: &Ir) -> bool {
+    let finite = ir.nodes.iter().all(|n| match &n.op {
+        Op::Const(v) => v.iter().all(|x| x.is_finite()),
+        _ => true,
+    });
+    let cost = ir.cost_estimate();
+    finite && cost.ops <= MAX_OPS && cost.elements_per_sample <= MAX_ELEMENTS_PER_SAMPLE
 }
 
 impl Checker<'_> {

@@ -41,9 +41,24 @@ impl<'a> Checker<'a> {
         let mut env: Env<'a> = None;
         for item in &module.items {
             if let Item::Stmt(s) = item {
+                let errors = self.error_count();
+                let emitted = self.statements.len();
                 env = self.stmt(s, env, &scx);
+                // A statement with an error is dropped whole (a bad time falls back to
+                // every frame): what is kept is right, for the IR warnings of a program
+                // that has errors elsewhere.
+                if self.error_count() > errors {
+                    self.statements.truncate(emitted);
+                }
             }
         }
+    }
+
+    fn error_count(&self) -> usize {
+        self.diags
+            .iter()
+            .filter(|d| d.severity == crate::lang::diag::Severity::Error)
+            .count()
     }
 
     fn block(&mut self, stmts: &'a [Stmt], env: &Env<'a>, scx: &Scx<'a>) {

@@ -1,0 +1,32 @@
+//! `mprog mcp`: serve the Model Context Protocol on stdin/stdout (see `mprog::mcp`).
+//! Nothing else may write to stdout while it runs: it carries the protocol.
+
+use miette::{Result, miette};
+use std::path::PathBuf;
+
+/// Arguments of `mprog mcp`.
+#[derive(clap::Args, Debug)]
+pub struct McpArgs {
+    /// Folder that runs write to and `score` reads from; requests name files in it by
+    /// relative path (created if missing).
+    #[arg(long, default_value = "mprog-out")]
+    pub out_dir: PathBuf,
+    /// Longest a run may take, in seconds; a longer one is stopped.
+    #[arg(long, default_value_t = 600)]
+    pub time_limit: u64,
+    /// Model bundle folder for runs (default: models/default or $MPROG_MODEL).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+}
+
+/// Runs `mprog mcp` until the client closes the connection.
+pub fn run(args: McpArgs) -> Result<()> {
+    let exe = std::env::current_exe().map_err(|e| miette!("cannot find this binary: {e}"))?;
+    let config = mprog::mcp::Config {
+        out_dir: args.out_dir,
+        exe,
+        model: args.model,
+        time_limit: std::time::Duration::from_secs(args.time_limit.max(1)),
+    };
+    mprog::mcp::serve_stdio(&config).map_err(|e| miette!("{e}"))
+}

@@ -1,0 +1,150 @@
+//! The tools that answer at once: `check`, `score`, `joints` and `library`. Each returns
+//! JSON; a program with errors is an answer (its diagnostics), not a failure.
+
+use super::paths::OutDir;
+use crate::formats::{LoadedMotion, read_motion};
+use crate::motion::Motion;
+use serde_json::{Value, json};
+
+/// The name programs from a request are reported under.
+pub const SOURCE_NAME: &str = "program.mprog";
+
+/// `check`: what `mprog check --format json` prints for the program.
+pub fn check(source: &str, set: &[(String, f64)]) -> Value {
+    let diags = crate::lang::check_source(source, SOURCE_NAME, set);
+    json!({
+        "file": SOURCE_NAME,
+        "ok": !diags.has_errors(),
+        "diagnostics": diags.to_json(),
+    })
+}
+
+/// `score`: the program's error on a motion file in the output folder, per statement.
+/// Err is a message for the caller (a program with errors, an unreadable file).
+pub fn score(
+    out: &OutDir,
+    source: &str,
+    motion: &str,
+    set: &[(String, f64)],
+) -> Result<Value, Value> {
+    let program = crate::lang::compile(source, SOURCE_NAME, set).map_err(|d| {
+        json!({"error": "the program has errors", "file": SOURCE_NAME, "ok": false,
+               "diagnostics": d.to_json()})
+    })?;
+    let fail = |m: String| json!({ "error": m });
+    let path = out.for_reading(motion).map_err(fail)?;
+    let people: Vec<Motion> = match read_motion(&path).map_err(|e| fail(e.to_string()))? {
+        LoadedMotion::Joints { people, .. } => people.into_iter().map(|p| p.motion).collect(),
+        LoadedMotion::Features(a) => vec![
+            crate::features::recover_from_ric(&a.data)
+                .map_err(|e| fail(format!("`{motion}`: {e}")))?,
+        ],
+    };
+    let wanted = program.people().len().max(1);
+    if people.len() != wanted {
+        return Err(fail(format!(
+            "the program has {wanted} people but `{motion}` holds {}",
+            people.len()
+        )));
+    }
+    let device = crate::backend::device_from_env().map_err(fail)?;
+    let joints = crate::view::program::people_tensor(&people, &device);
+    let e = program
+        .try_evaluate(joints)
+        .map_err(|e| fail(e.to_string()))?;
+    let per: Vec<f32> = e
+        .per_statement
+        .into_data()
+        .convert::<f32>()
+        .try_into_vec::<f32>()
+        .map_err(|e| fail(format!("{e:?}")))?;
+    let statements: Vec<Value> = program
+        .statements()
+        .iter()
+        .zip(&per)
+        .map(|(s, e)| json!({"line": s.line, "statement": statement_text(&s.label), "unit": s.unit, "error": e}))
+        .collect();
+    Ok(json!({
+        "motion": motion,
+        "frames": people[0].len(),
+        "statements": statements,
+        "total": per.iter().sum::<f32>(),
+    }))
+}
+
+/// `line 3: head.y > 1 m` → `head.y > 1 m`.
+pub fn statement_text(label: &str) -> &str {
+    label.split_once(": ").map_or(label, |(_, t)| t).trim()
+}
+
+/// `joints`: the skeleton's joints with their indices and aliases.
+pub fn joints() -> Value {
+    let joints: Vec<Value> = crate::skeleton::JOINT_NAMES
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let aliases: Vec<&str> = crate::skeleton::ALIASES
+                .iter()
+                .filter(|(_, j)| *j == i)
+                .map(|(a, _)| *a)
+                .collect();
+            json!({"index": i, "name": name, "aliases": aliases})
+        })
+        .collect();
+    json!({
+        "conventions": "metres, Y up, 20 fps; at frame 0 the person stands at x = z = 0 facing +Z, their left at +X",
+        "joints": joints,
+    })
+}
+
+/// `library`: the library reference (builtins and the standard library), as markdown.
+pub fn library() -> String {
+    crate::docgen::library::stdlib_reference()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn check_reports_located_diagnostics() {
+        let v = check("length 4s\nalways { r_hnad.y > 1 m }\n", &[]);
+        assert_eq!(v["ok"], false);
+        let d = &v["diagnostics"][0];
+        assert_eq!(d["code"], "mprog::unknown_joint");
+        assert_eq!(
+            (d["line"].as_u64(), d["column"].as_u64()),
+            (Some(2), Some(10))
+        );
+        assert!(d["hint"].as_str().unwrap().contains("r_hand"));
+        assert_eq!(
+            check("length 4s\nalways { head.y > 1 m }\n", &[])["ok"],
+            true
+        );
+    }
+
+    #[test]
+    fn score_reads_only_inside_the_output_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = OutDir::new(&dir.path().join("out")).unwrap();
+        let motion = Motion::new(vec![crate::skeleton::rest_pose(); 10]);
+        let job = crate::formats::OutputJob {
+            people: std::slice::from_ref(&motion),
+            meta: &crate::motion::Meta::new(),
+            title: "",
+            bvh: &Default::default(),
+        };
+        crate::formats::write_outputs(&[out.root().join("m.json")], &job).unwrap();
+        let src = "length 10 frames\nalways { head.y > 3 m }\n";
+        let v = score(&out, src, "m.json", &[]).unwrap();
+        assert_eq!(v["statements"][0]["line"], 2);
+        assert!(v["total"].as_f64().unwrap() > 1.0, "{v}");
+        let e = score(&out, src, "../m.json", &[]).unwrap_err();
+        assert!(
+            e["error"].as_str().unwrap().starts_with("refused path"),
+            "{e}"
+        );
+        let e = score(&out, "length 1s\nalways { hed.y > 1 m }", "m.json", &[]).unwrap_err();
+        assert_eq!(e["diagnostics"][0]["code"], "mprog::unknown_joint", "{e}");
+    }
+}
