@@ -13,6 +13,7 @@ fn config(out: &std::path::Path) -> Config {
         exe: "/nonexistent/mprog".into(),
         model: None,
         time_limit: Duration::from_secs(5),
+        card: None,
     }
 }
 

@@ -22,11 +22,23 @@ pub struct McpArgs {
 /// Runs `mprog mcp` until the client closes the connection.
 pub fn run(args: McpArgs) -> Result<()> {
     let exe = std::env::current_exe().map_err(|e| miette!("cannot find this binary: {e}"))?;
+    // The card lists the actions of the model the runs use.
+    let model_dir = args
+        .model
+        .clone()
+        .unwrap_or_else(mprog::model::weights::default_model_dir);
+    let actions: Vec<(String, usize)> = mprog::model::weights::trained_actions(&model_dir)
+        .unwrap_or_default()
+        .into_iter()
+        .map(|a| (a.caption, a.clips))
+        .collect();
+    let card = mprog::docgen::prompt::system_prompt_for(&actions);
     let config = mprog::mcp::Config {
         out_dir: args.out_dir,
         exe,
         model: args.model,
         time_limit: std::time::Duration::from_secs(args.time_limit.max(1)),
+        card: Some(card),
     };
     mprog::mcp::serve_stdio(&config).map_err(|e| miette!("{e}"))
 }

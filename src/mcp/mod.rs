@@ -36,6 +36,9 @@ pub struct Config {
     pub model: Option<PathBuf>,
     /// Longest a run may take.
     pub time_limit: Duration,
+    /// The prompt card served as the MCP prompt and resource (None: the card without the
+    /// model's action list); the CLI passes the one for the model runs use.
+    pub card: Option<String>,
 }
 
 /// The handler for `config`.
@@ -47,6 +50,12 @@ pub fn server(config: &Config) -> std::io::Result<server::Server> {
             config.model.clone(),
             config.time_limit,
         )),
+        card: std::sync::Arc::new(
+            config
+                .card
+                .clone()
+                .unwrap_or_else(crate::docgen::prompt::system_prompt),
+        ),
     })
 }
 
@@ -147,6 +156,7 @@ pub fn fuzz_one(data: &[u8]) -> Result<(), String> {
         exe: dir.path().join("no-runner"),
         model: None,
         time_limit: Duration::from_secs(2),
+        card: None,
     })
     .map_err(|e| e.to_string())?;
     let mut input = HANDSHAKE.as_bytes().to_vec();

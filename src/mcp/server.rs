@@ -25,6 +25,8 @@ use std::sync::Arc;
 pub struct Server {
     pub(super) out: OutDir,
     pub(super) runner: Arc<Runner>,
+    /// The prompt card (with the model's actions when the CLI knows them).
+    pub(super) card: Arc<String>,
 }
 
 fn text_result(v: &Value, error: bool) -> CallToolResult {
@@ -162,7 +164,7 @@ impl ServerHandler for Server {
                 None,
             ));
         }
-        let card = crate::docgen::prompt::system_prompt();
+        let card = self.card.as_str().to_string();
         Ok(GetPromptResult::new(vec![PromptMessage::new_text(Role::User, card)]).into())
     }
 
@@ -187,7 +189,7 @@ impl ServerHandler for Server {
         _context: RequestContext<RoleServer>,
     ) -> Result<ReadResourceResponse, McpError> {
         let text = match request.uri.as_str() {
-            CARD_URI => crate::docgen::prompt::system_prompt(),
+            CARD_URI => self.card.as_str().to_string(),
             LIBRARY_URI => calls::library(),
             other => {
                 return Err(McpError::resource_not_found(
