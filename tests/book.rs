@@ -238,3 +238,17 @@ fn prompt_examples_compile_and_cover_the_library() {
         }
     }
 }
+
+#[test]
+fn every_diagnostic_code_is_on_the_diagnostics_page() {
+    let page = std::fs::read_to_string(root().join("book/src/reference/diagnostics.md")).unwrap();
+    let missing: Vec<&str> = mprog::lang::codes::ALL
+        .iter()
+        .map(|(code, _)| *code)
+        .filter(|code| !page.contains(&format!("`{code}`")))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "codes missing from book/src/reference/diagnostics.md: {missing:?}"
+    );
+}

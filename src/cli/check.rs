@@ -66,7 +66,7 @@ fn with_prompt_warnings(diags: Diagnostics, source: &str, text: &PromptEncoder) 
         {
             items.push(
                 Diagnostic::warning(
-                    "mprog::far_prompt",
+                    mprog::lang::codes::FAR_PROMPT,
                     span,
                     format!("the motion model was never trained on anything like \"{prompt}\""),
                 )

@@ -61,7 +61,7 @@ mod tests {
             (b[0].lang.as_str(), b[0].text.as_str(), b[0].line),
             ("mprog", "head.y > 1\n", 2)
         );
-        assert_eq!(b[1].attrs, vec!["error", "mprog::unknown_joint"]);
+        assert_eq!(b[1].attrs, vec!["error", crate::lang::codes::UNKNOWN_JOINT]);
         assert_eq!(b[2].lang, "");
     }
 }

@@ -11,6 +11,7 @@
 //! is described in `book/src/reference/language.md` (the book) (syntax, semantics, the scale of the total error).
 
 pub mod check;
+pub mod codes;
 pub mod diag;
 pub mod eval;
 pub mod ir;

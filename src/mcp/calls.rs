@@ -111,7 +111,7 @@ mod tests {
         let v = check("length 4s\nalways { r_hnad.y > 1 m }\n", &[]);
         assert_eq!(v["ok"], false);
         let d = &v["diagnostics"][0];
-        assert_eq!(d["code"], "mprog::unknown_joint");
+        assert_eq!(d["code"], crate::lang::codes::UNKNOWN_JOINT);
         assert_eq!(
             (d["line"].as_u64(), d["column"].as_u64()),
             (Some(2), Some(10))
@@ -145,6 +145,10 @@ mod tests {
             "{e}"
         );
         let e = score(&out, "length 1s\nalways { hed.y > 1 m }", "m.json", &[]).unwrap_err();
-        assert_eq!(e["diagnostics"][0]["code"], "mprog::unknown_joint", "{e}");
+        assert_eq!(
+            e["diagnostics"][0]["code"],
+            crate::lang::codes::UNKNOWN_JOINT,
+            "{e}"
+        );
     }
 }

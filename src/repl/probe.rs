@@ -64,7 +64,7 @@ pub fn compile_probe(session: &Session, text: &str) -> Result<Probe, Reply> {
         .items
         .iter()
         .filter(|i| i.severity == crate::lang::Severity::Error)
-        .all(|i| i.code == "mprog::not_a_constraint");
+        .all(|i| i.code == crate::lang::codes::NOT_A_CONSTRAINT);
     if !real_errors(&as_statement) {
         return Err(Reply::error(
             "nothing to evaluate: the input has no constraint or value",
@@ -78,9 +78,9 @@ pub fn compile_probe(session: &Session, text: &str) -> Result<Probe, Reply> {
     match attempt(format!("minimize ({text})"), Kind::Scalar) {
         Ok(p) => Ok(p),
         Err(d)
-            if d.items
-                .iter()
-                .any(|i| i.code == "mprog::type_mismatch" && i.message.contains("vector")) =>
+            if d.items.iter().any(|i| {
+                i.code == crate::lang::codes::TYPE_MISMATCH && i.message.contains("vector")
+            }) =>
         {
             let code = ["x", "y", "z"]
                 .map(|c| format!("minimize ({text}).{c}"))
@@ -92,17 +92,16 @@ pub fn compile_probe(session: &Session, text: &str) -> Result<Probe, Reply> {
 }
 
 fn without_not_constraint(d: Diagnostics) -> Diagnostics {
-    let others = d
-        .items
-        .iter()
-        .any(|i| i.code != "mprog::not_a_constraint" && i.severity == crate::lang::Severity::Error);
+    let others = d.items.iter().any(|i| {
+        i.code != crate::lang::codes::NOT_A_CONSTRAINT && i.severity == crate::lang::Severity::Error
+    });
     if !others {
         return d;
     }
     let items = d
         .items
         .into_iter()
-        .filter(|i| i.code != "mprog::not_a_constraint")
+        .filter(|i| i.code != crate::lang::codes::NOT_A_CONSTRAINT)
         .collect();
     Diagnostics::new(&d.name, d.source, items)
 }

@@ -29,7 +29,10 @@ pub const SOURCE_NAME: &str = "<repl>";
 
 /// Diagnostics the REPL does not show: a session starts with no length and no
 /// constraints, and that is fine until a motion is scored.
-const QUIET: &[&str] = &["mprog::missing_length", "mprog::empty_program"];
+const QUIET: &[&str] = &[
+    crate::lang::codes::MISSING_LENGTH,
+    crate::lang::codes::EMPTY_PROGRAM,
+];
 
 /// The motion commands work on.
 #[derive(Clone, Debug)]

@@ -16,7 +16,7 @@ pub fn warnings(ir: &Ir) -> Vec<Diagnostic> {
         let s = &ir.statements[n.statement];
         out.push(
             Diagnostic::warning(
-                "mprog::never_met",
+                crate::lang::codes::NEVER_MET,
                 s.span,
                 format!(
                     "no motion can meet this constraint: its error is at least {:.3} {}",
@@ -38,7 +38,7 @@ pub fn warnings(ir: &Ir) -> Vec<Diagnostic> {
         let s = &ir.statements[r.statement];
         out.push(
             Diagnostic::warning(
-                "mprog::out_of_reach",
+                crate::lang::codes::OUT_OF_REACH,
                 s.span,
                 format!(
                     "without a step, the {} cannot get here: the place is {:.2} m beyond its \
@@ -69,7 +69,7 @@ pub fn warnings(ir: &Ir) -> Vec<Diagnostic> {
         let (a, b) = j.frames;
         out.push(
             Diagnostic::warning(
-                "mprog::frame_jump",
+                crate::lang::codes::FRAME_JUMP,
                 s.span,
                 format!(
                     "this and {other} make the {} move at least {:.2} m between frame {a} \

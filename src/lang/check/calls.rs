@@ -54,7 +54,7 @@ impl<'a> Checker<'a> {
         };
         self.error(
             cx,
-            "mprog::unknown_function",
+            crate::lang::codes::UNKNOWN_FUNCTION,
             name.span,
             format!("unknown function `{n}`"),
         )
@@ -66,7 +66,7 @@ impl<'a> Checker<'a> {
     fn arity_error(&mut self, n: &str, signature: &str, got: usize, span: Span, cx: &Cx) {
         self.error(
             cx,
-            "mprog::arity",
+            crate::lang::codes::ARITY,
             span,
             format!(
                 "`{n}` called with {got} argument{}",
@@ -101,7 +101,7 @@ impl<'a> Checker<'a> {
         if cx.depth >= MAX_CALL_DEPTH {
             self.error(
                 cx,
-                "mprog::too_deep",
+                crate::lang::codes::TOO_DEEP,
                 span,
                 format!("function calls nested more than {MAX_CALL_DEPTH} deep"),
             )
@@ -154,7 +154,7 @@ impl<'a> Checker<'a> {
                     0 => {
                         self.error(
                             &fcx,
-                            "mprog::empty_function",
+                            crate::lang::codes::EMPTY_FUNCTION,
                             f.span,
                             format!("`{n}` computes nothing"),
                         )
@@ -166,7 +166,7 @@ impl<'a> Checker<'a> {
                         let mut acc: Option<Rc<Formula>> = None;
                         for (v, s) in vals {
                             let Val::Formula(fm) = v else {
-                                self.error(&fcx, "mprog::type_mismatch", s, format!("{} in a body with several expressions", v.describe()))
+                                self.error(&fcx, crate::lang::codes::TYPE_MISMATCH, s, format!("{} in a body with several expressions", v.describe()))
                                     .label("not a constraint")
                                     .help("a body with several expressions returns all of them as constraints (AND); use `let` for values");
                                 return Val::Error;
@@ -199,7 +199,7 @@ impl<'a> Checker<'a> {
         };
         self.error(
             cx,
-            "mprog::type_mismatch",
+            crate::lang::codes::TYPE_MISMATCH,
             e.span,
             format!("`{fname}` needs {want} here, found {got}"),
         )
@@ -228,7 +228,7 @@ impl<'a> Checker<'a> {
                 other => {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         e.span,
                         format!("`{}` needs a person, found {}", b.name, other.describe()),
                     )
@@ -242,7 +242,7 @@ impl<'a> Checker<'a> {
                 let first = self.header.people[0].name.clone();
                 self.error(
                     cx,
-                    "mprog::needs_person",
+                    crate::lang::codes::NEEDS_PERSON,
                     span,
                     format!("`{}` needs to know which person", b.name),
                 )
@@ -281,7 +281,7 @@ impl<'a> Checker<'a> {
                 other => {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         args[0].span,
                         format!("`parent` needs a joint, found {}", other.describe()),
                     )
@@ -318,7 +318,7 @@ impl<'a> Checker<'a> {
                 if point.unit.unify(Unit::M).is_none() {
                     self.error(
                         cx,
-                        "mprog::unit_mismatch",
+                        crate::lang::codes::UNIT_MISMATCH,
                         args[0].span,
                         format!("`supportDist` needs a point in m, found {}", point.unit),
                     )
@@ -459,7 +459,7 @@ impl<'a> Checker<'a> {
             if u.is_none() {
                 s.error(
                     cx,
-                    "mprog::unit_mismatch",
+                    crate::lang::codes::UNIT_MISMATCH,
                     span,
                     format!("`{name}` mixes {} and {}", x.unit, y.unit),
                 )
@@ -503,7 +503,7 @@ impl<'a> Checker<'a> {
                 let Some(unit) = unit else {
                     self.error(
                         cx,
-                        "mprog::unit_mismatch",
+                        crate::lang::codes::UNIT_MISMATCH,
                         args[0].span,
                         format!("`sqrt` of {} has no unit", v[0].unit),
                     )
@@ -519,7 +519,7 @@ impl<'a> Checker<'a> {
                 if !v[0].unit.is_angle_like() {
                     self.error(
                         cx,
-                        "mprog::unit_mismatch",
+                        crate::lang::codes::UNIT_MISMATCH,
                         args[0].span,
                         format!("`{name}` needs an angle, found {}", v[0].unit),
                     )
@@ -537,7 +537,7 @@ impl<'a> Checker<'a> {
                 if v[0].vector != v[1].vector {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         span,
                         format!("`{name}` of a scalar and a vector"),
                     )
@@ -568,7 +568,7 @@ impl<'a> Checker<'a> {
                 if v[1].vector || v[2].vector {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         span,
                         "`clamp` bounds must be scalars",
                     )

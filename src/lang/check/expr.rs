@@ -39,7 +39,7 @@ impl<'a> Checker<'a> {
         self.work += 1;
         if self.work > super::MAX_WORK {
             if self.work == super::MAX_WORK + 1 {
-                self.error(cx, "mprog::too_costly", e.span, format!("checking needs more than {} steps", super::MAX_WORK))
+                self.error(cx, crate::lang::codes::TOO_COSTLY, e.span, format!("checking needs more than {} steps", super::MAX_WORK))
                     .label("expands too much")
                     .help("functions are inlined where they are called; avoid functions that use an argument many times inside other such functions");
             }
@@ -50,7 +50,7 @@ impl<'a> Checker<'a> {
                 if *u == Some(UnitLit::Percent) {
                     self.error(
                         cx,
-                        "mprog::misplaced_percent",
+                        crate::lang::codes::MISPLACED_PERCENT,
                         e.span,
                         "`%` is only meaningful as a time position",
                     )
@@ -133,7 +133,7 @@ impl<'a> Checker<'a> {
                     .map_or("a".to_string(), |p| p.name.clone());
                 self.error(
                     cx,
-                    "mprog::needs_person",
+                    crate::lang::codes::NEEDS_PERSON,
                     span,
                     format!("whose `{name}`? this program has several people"),
                 )
@@ -154,7 +154,7 @@ impl<'a> Checker<'a> {
                 };
                 self.error(
                     cx,
-                    "mprog::type_mismatch",
+                    crate::lang::codes::TYPE_MISMATCH,
                     span,
                     format!("expected a number or point, found {}", other.describe()),
                 )
@@ -206,7 +206,7 @@ impl<'a> Checker<'a> {
             "start" | "mid" | "end" => {
                 self.error(
                     cx,
-                    "mprog::misplaced_time",
+                    crate::lang::codes::MISPLACED_TIME,
                     span,
                     format!("`{n}` is a time position, not a value"),
                 )
@@ -232,7 +232,7 @@ impl<'a> Checker<'a> {
         {
             self.error(
                 cx,
-                "mprog::type_mismatch",
+                crate::lang::codes::TYPE_MISMATCH,
                 span,
                 format!("`{n}` is a function"),
             )
@@ -258,9 +258,9 @@ impl<'a> Checker<'a> {
             .as_ref()
             .is_some_and(|b| candidates[..joint_count].contains(b));
         let code = if is_joint {
-            "mprog::unknown_joint"
+            crate::lang::codes::UNKNOWN_JOINT
         } else {
-            "mprog::unknown_name"
+            crate::lang::codes::UNKNOWN_NAME
         };
         let what = if is_joint { "joint" } else { "name" };
         let help = match best {
@@ -319,7 +319,7 @@ impl<'a> Checker<'a> {
                     _ => {
                         self.error(
                             cx,
-                            "mprog::type_mismatch",
+                            crate::lang::codes::TYPE_MISMATCH,
                             e.span,
                             "a loop variable cannot go into a joint list",
                         )
@@ -331,7 +331,7 @@ impl<'a> Checker<'a> {
             if set.iter().any(|(p, _)| p.is_none()) && set.iter().any(|(p, _)| p.is_some()) {
                 self.error(
                     cx,
-                    "mprog::type_mismatch",
+                    crate::lang::codes::TYPE_MISMATCH,
                     span,
                     "mix of joints with and without a person",
                 )
@@ -357,7 +357,7 @@ impl<'a> Checker<'a> {
         if vals.len() != 3 {
             self.error(
                 cx,
-                "mprog::bad_list",
+                crate::lang::codes::BAD_LIST,
                 span,
                 format!("a vector needs 3 numbers, this list has {}", vals.len()),
             )
@@ -372,7 +372,7 @@ impl<'a> Checker<'a> {
                 Some(_) => {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         e.span,
                         "a vector's entries must be scalars",
                     )
@@ -390,7 +390,7 @@ impl<'a> Checker<'a> {
                 None => {
                     self.error(
                         cx,
-                        "mprog::unit_mismatch",
+                        crate::lang::codes::UNIT_MISMATCH,
                         e.span,
                         format!("vector entries mix {unit} and {}", n.unit),
                     )
@@ -426,7 +426,7 @@ impl<'a> Checker<'a> {
             };
             self.error(
                 cx,
-                "mprog::unknown_person",
+                crate::lang::codes::UNKNOWN_PERSON,
                 base.span,
                 format!("no person named `{n}`"),
             )
@@ -462,7 +462,7 @@ impl<'a> Checker<'a> {
                 };
                 self.error(
                     cx,
-                    "mprog::unknown_joint",
+                    crate::lang::codes::UNKNOWN_JOINT,
                     field.span,
                     format!("unknown joint `{f}`"),
                 )
@@ -477,7 +477,7 @@ impl<'a> Checker<'a> {
                 if !n.vector {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         field.span,
                         format!("a scalar has no component `.{f}`"),
                     )
@@ -505,7 +505,7 @@ impl<'a> Checker<'a> {
                         };
                         self.error(
                             cx,
-                            "mprog::unknown_component",
+                            crate::lang::codes::UNKNOWN_COMPONENT,
                             field.span,
                             format!("no component `.{f}`"),
                         )

@@ -161,7 +161,7 @@ mod tests {
         let d = check_source(source, "t.mprog", &[]);
         assert_eq!(d.error_count(), 0, "{}", d.render_plain());
         d.warnings()
-            .filter(|w| w.code == "mprog::never_met")
+            .filter(|w| w.code == crate::lang::codes::NEVER_MET)
             .count()
     }
 

@@ -79,7 +79,7 @@ impl<'a> Checker<'a> {
         for (name, _) in overrides {
             if !self.header.params.iter().any(|p| &p.name == name) {
                 let mut d = Diagnostic::error(
-                    "mprog::unknown_param",
+                    crate::lang::codes::UNKNOWN_PARAM,
                     Span::new(0, 0),
                     format!("`--set {name}=…` names no parameter of this program"),
                 );
@@ -100,7 +100,7 @@ impl<'a> Checker<'a> {
         let line = self.line_of(first.start);
         self.error(
             cx,
-            "mprog::duplicate",
+            crate::lang::codes::DUPLICATE,
             span,
             format!("a second `{what}` line"),
         )
@@ -116,7 +116,7 @@ impl<'a> Checker<'a> {
             if joint_index(n).is_some() || RESERVED.contains(&n) {
                 self.error(
                     cx,
-                    "mprog::reserved_name",
+                    crate::lang::codes::RESERVED_NAME,
                     p.name.span,
                     format!("`{n}` cannot name a person"),
                 )
@@ -129,7 +129,7 @@ impl<'a> Checker<'a> {
             if self.header.people.iter().any(|q| q.name == n) {
                 self.error(
                     cx,
-                    "mprog::duplicate",
+                    crate::lang::codes::DUPLICATE,
                     p.name.span,
                     format!("person `{n}` is declared twice"),
                 )
@@ -154,7 +154,7 @@ impl<'a> Checker<'a> {
             {
                 self.error(
                     cx,
-                    "mprog::reserved_name",
+                    crate::lang::codes::RESERVED_NAME,
                     f.name.span,
                     format!("`{n}` is a built-in name"),
                 )
@@ -166,7 +166,7 @@ impl<'a> Checker<'a> {
                 let line = self.line_of(prev.span.start);
                 self.error(
                     cx,
-                    "mprog::duplicate",
+                    crate::lang::codes::DUPLICATE,
                     f.name.span,
                     format!("function `{n}` is defined twice"),
                 )
@@ -181,7 +181,7 @@ impl<'a> Checker<'a> {
                 if !seen.insert(p.name.as_str()) {
                     self.error(
                         cx,
-                        "mprog::duplicate",
+                        crate::lang::codes::DUPLICATE,
                         p.span,
                         format!("parameter `{}` appears twice", p.name),
                     )
@@ -225,7 +225,7 @@ impl<'a> Checker<'a> {
                 reported.extend(cycle.iter().copied());
                 let span = self.user_fns[start].name.span;
                 let path = cycle.join(" → ");
-                self.error(cx, "mprog::recursion", span, format!("function `{start}` calls itself: {path}"))
+                self.error(cx, crate::lang::codes::RECURSION, span, format!("function `{start}` calls itself: {path}"))
                     .label("recursive")
                     .help("mprog has no recursion; repeat work with `for` over a list, or write the steps out");
             }
@@ -252,7 +252,7 @@ impl<'a> Checker<'a> {
         {
             self.error(
                 cx,
-                "mprog::reserved_name",
+                crate::lang::codes::RESERVED_NAME,
                 name.span,
                 format!("`{n}` cannot name a parameter"),
             )
@@ -263,7 +263,7 @@ impl<'a> Checker<'a> {
         if self.header.params.iter().any(|p| p.name == n) {
             self.error(
                 cx,
-                "mprog::duplicate",
+                crate::lang::codes::DUPLICATE,
                 name.span,
                 format!("parameter `{n}` is declared twice"),
             )
@@ -276,7 +276,7 @@ impl<'a> Checker<'a> {
             if val != Val::Error {
                 self.error(
                     cx,
-                    "mprog::type_mismatch",
+                    crate::lang::codes::TYPE_MISMATCH,
                     value.span,
                     format!(
                         "a parameter must be a number or vector, not {}",
@@ -294,7 +294,7 @@ impl<'a> Checker<'a> {
         else {
             self.error(
                 cx,
-                "mprog::not_constant",
+                crate::lang::codes::NOT_CONSTANT,
                 value.span,
                 "a parameter's value must be constant",
             )
@@ -311,7 +311,7 @@ impl<'a> Checker<'a> {
             if num.vector {
                 self.error(
                     cx,
-                    "mprog::bad_override",
+                    crate::lang::codes::BAD_OVERRIDE,
                     name.span,
                     format!("`--set {n}=…` cannot replace a vector"),
                 )
@@ -319,7 +319,7 @@ impl<'a> Checker<'a> {
             } else if !v.is_finite() || !((v * scale) as f32).is_finite() {
                 self.error(
                     cx,
-                    "mprog::bad_override",
+                    crate::lang::codes::BAD_OVERRIDE,
                     name.span,
                     format!("`--set {n}` needs a finite number (|x| ≤ 3.4e38), got {v}"),
                 )
@@ -355,7 +355,7 @@ impl<'a> Checker<'a> {
             if !self.multi {
                 self.error(
                     cx,
-                    "mprog::spacing_needs_people",
+                    crate::lang::codes::SPACING_NEEDS_PEOPLE,
                     *span,
                     "`spacing` places several people, and this program has one",
                 )
@@ -379,7 +379,7 @@ impl<'a> Checker<'a> {
                     };
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         value.span,
                         format!("`spacing` needs a distance in metres, not {what}"),
                     )
@@ -390,7 +390,7 @@ impl<'a> Checker<'a> {
             let Some(metres) = metres else {
                 self.error(
                     cx,
-                    "mprog::not_constant",
+                    crate::lang::codes::NOT_CONSTANT,
                     value.span,
                     "the spacing must be constant",
                 )
@@ -401,7 +401,7 @@ impl<'a> Checker<'a> {
             if !(MIN_SPACING..=MAX_SPACING).contains(&metres) {
                 self.error(
                     cx,
-                    "mprog::bad_spacing",
+                    crate::lang::codes::BAD_SPACING,
                     value.span,
                     format!("a spacing of {metres} m is out of range"),
                 )
@@ -432,7 +432,7 @@ impl<'a> Checker<'a> {
             if t.fraction != 0.0 {
                 self.error(
                     cx,
-                    "mprog::bad_length",
+                    crate::lang::codes::BAD_LENGTH,
                     value.span,
                     "the length cannot be relative to itself",
                 )
@@ -444,7 +444,7 @@ impl<'a> Checker<'a> {
             if !(2.0..=MAX_LENGTH as f64).contains(&frames) {
                 self.error(
                     cx,
-                    "mprog::bad_length",
+                    crate::lang::codes::BAD_LENGTH,
                     value.span,
                     format!("a length of {frames} frames is out of range"),
                 )
@@ -457,7 +457,7 @@ impl<'a> Checker<'a> {
                 continue;
             }
             if frames as usize > MODEL_MAX_FRAMES {
-                self.error(cx, "mprog::long_motion", value.span, format!("{frames} frames is longer than the model generates"))
+                self.error(cx, crate::lang::codes::LONG_MOTION, value.span, format!("{frames} frames is longer than the model generates"))
                     .label("longer than 9.8 s")
                     .help(format!("the motion model makes at most {MODEL_MAX_FRAMES} frames (9.8 s); longer motions must be stitched"))
                     .warning();
@@ -470,7 +470,7 @@ impl<'a> Checker<'a> {
             None => {
                 self.diags.push(
                     Diagnostic::warning(
-                        "mprog::missing_length",
+                        crate::lang::codes::MISSING_LENGTH,
                         Span::new(0, 0),
                         "no `length` line; using 196 frames (9.8 s)",
                     )

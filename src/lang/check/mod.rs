@@ -230,7 +230,7 @@ pub fn module_to_ir<'a>(
     if c.b.overflow {
         c.diags.push(
             Diagnostic::error(
-                "mprog::too_costly",
+                crate::lang::codes::TOO_COSTLY,
                 Span::default(),
                 format!(
                     "the program expands to more than {} tensor ops",
@@ -244,7 +244,7 @@ pub fn module_to_ir<'a>(
     if c.statements.is_empty() && !has_errors {
         c.diags.push(
             Diagnostic::error(
-                "mprog::empty_program",
+                crate::lang::codes::EMPTY_PROGRAM,
                 Span::new(0, 0),
                 "the program has no constraints",
             )
@@ -274,7 +274,7 @@ pub fn module_to_ir<'a>(
         {
             c.diags.push(
                 Diagnostic::error(
-                    "mprog::number_out_of_range",
+                    crate::lang::codes::NUMBER_OUT_OF_RANGE,
                     node.span,
                     format!("this value is {x} in 32-bit floats (|x| ≤ 3.4e38)"),
                 )
@@ -290,7 +290,7 @@ pub fn module_to_ir<'a>(
     if cost.ops > MAX_OPS || cost.elements_per_sample > MAX_ELEMENTS_PER_SAMPLE {
         c.diags.push(
             Diagnostic::error(
-                "mprog::too_costly",
+                crate::lang::codes::TOO_COSTLY,
                 Span::new(0, 0),
                 format!(
                     "evaluating this program is estimated at {} tensor ops and {} elements per \

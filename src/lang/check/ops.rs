@@ -24,7 +24,7 @@ impl<'a> Checker<'a> {
             (UnOp::Not, other) => {
                 self.error(
                     cx,
-                    "mprog::type_mismatch",
+                    crate::lang::codes::TYPE_MISMATCH,
                     arg.span,
                     format!("`not` needs a constraint, found {}", other.describe()),
                 )
@@ -35,7 +35,7 @@ impl<'a> Checker<'a> {
             (UnOp::Neg, Val::Formula(_)) => {
                 self.error(
                     cx,
-                    "mprog::type_mismatch",
+                    crate::lang::codes::TYPE_MISMATCH,
                     arg.span,
                     "`-` cannot negate a constraint",
                 )
@@ -81,7 +81,7 @@ impl<'a> Checker<'a> {
                     };
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         e.span,
                         format!(
                             "`{}` joins constraints, found {}",
@@ -98,7 +98,7 @@ impl<'a> Checker<'a> {
         if op.is_comparison() && (matches!(va, Val::Formula(_)) || matches!(vb, Val::Formula(_))) {
             self.error(
                 cx,
-                "mprog::chained_comparison",
+                crate::lang::codes::CHAINED_COMPARISON,
                 span,
                 "comparisons cannot be chained",
             )
@@ -128,7 +128,7 @@ impl<'a> Checker<'a> {
             if u.is_none() {
                 s.error(
                     cx,
-                    "mprog::unit_mismatch",
+                    crate::lang::codes::UNIT_MISMATCH,
                     span,
                     format!("cannot {what} {} and {}", x.unit, y.unit),
                 )
@@ -140,13 +140,13 @@ impl<'a> Checker<'a> {
         match op {
             BinOp::Eq | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => {
                 if x.vector != y.vector && op == BinOp::Eq {
-                    self.error(cx, "mprog::type_mismatch", span, format!("`==` compares a {} with a {}", kind(&x), kind(&y)))
+                    self.error(cx, crate::lang::codes::TYPE_MISMATCH, span, format!("`==` compares a {} with a {}", kind(&x), kind(&y)))
                         .label("different kinds")
                         .help("compare a vector with a vector (distance) or a component with a number, e.g. `head.y == 1.6 m`");
                     return Val::Error;
                 }
                 if op != BinOp::Eq && !x.vector && y.vector {
-                    self.error(cx, "mprog::type_mismatch", span, format!("`{}` compares a scalar with a vector", op.symbol()))
+                    self.error(cx, crate::lang::codes::TYPE_MISMATCH, span, format!("`{}` compares a scalar with a vector", op.symbol()))
                         .label("different kinds")
                         .help("put the vector on the left (all components), or compare components such as `.y`");
                     return Val::Error;
@@ -166,7 +166,7 @@ impl<'a> Checker<'a> {
                 if x.vector != y.vector {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         span,
                         format!(
                             "cannot {} a {} and a {}",
@@ -199,7 +199,7 @@ impl<'a> Checker<'a> {
                 if x.vector && y.vector {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         span,
                         "cannot multiply two vectors",
                     )
@@ -218,7 +218,7 @@ impl<'a> Checker<'a> {
                 if y.vector {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         spans.1,
                         "cannot divide by a vector",
                     )
@@ -227,9 +227,14 @@ impl<'a> Checker<'a> {
                     return Val::Error;
                 }
                 if self.b.const_of(y.node).is_some_and(|v| v.contains(&0.0)) {
-                    self.error(cx, "mprog::division_by_zero", spans.1, "division by zero")
-                        .label("is 0")
-                        .help("divide by a non-zero constant");
+                    self.error(
+                        cx,
+                        crate::lang::codes::DIVISION_BY_ZERO,
+                        spans.1,
+                        "division by zero",
+                    )
+                    .label("is 0")
+                    .help("divide by a non-zero constant");
                     return Val::Error;
                 }
                 let node = self.b.binary(BinaryOp::Div, x.node, y.node, span);

@@ -321,7 +321,7 @@ mod tests {
     fn a_wrist_out_of_reach_without_a_step_is_flagged() {
         // The right shoulder starts at (-0.17, 1.34, 0); 0.79 m ahead of it is too far.
         let far = "at 2s { r_wrist == [-0.17, 1.34, 0.79] }";
-        assert_eq!(codes(far), ["mprog::out_of_reach"]);
+        assert_eq!(codes(far), [crate::lang::codes::OUT_OF_REACH]);
         // Within the arm's reach, or with a step asked for, it is not.
         assert!(codes("at 2s { dist(r_wrist, [-0.17, 1.34, 0.6]) < 5 cm }").is_empty());
         let walk = format!("{far}\nat 2s {{ groundDist(pelvis, [0, 0, 0.5]) < 20 cm }}");
@@ -334,12 +334,15 @@ mod tests {
     fn a_jump_between_consecutive_frames_is_flagged() {
         let jump =
             "at 1s { abs(r_wrist.x - 0.3 m) < 1 cm }\nat 1.05s { abs(r_wrist.x + 0.3 m) < 1 cm }";
-        assert_eq!(codes(jump), ["mprog::frame_jump"]);
+        assert_eq!(codes(jump), [crate::lang::codes::FRAME_JUMP]);
         let slow =
             "at 1s { abs(r_wrist.x - 0.3 m) < 1 cm }\nat 2s { abs(r_wrist.x + 0.3 m) < 1 cm }";
         assert!(codes(slow).is_empty());
         // 24 cm from the pinned start place in one frame.
-        assert_eq!(codes("at 1 { pelvis.x > 26 cm }"), ["mprog::frame_jump"]);
+        assert_eq!(
+            codes("at 1 { pelvis.x > 26 cm }"),
+            [crate::lang::codes::FRAME_JUMP]
+        );
         assert!(codes("at 1s { pelvis.x > 26 cm }").is_empty());
     }
 
@@ -357,7 +360,12 @@ mod tests {
             let d = check_source(&source, "t.mprog", &[]);
             let new: Vec<_> = d
                 .warnings()
-                .filter(|w| matches!(w.code, "mprog::out_of_reach" | "mprog::frame_jump"))
+                .filter(|w| {
+                    matches!(
+                        w.code,
+                        crate::lang::codes::OUT_OF_REACH | crate::lang::codes::FRAME_JUMP
+                    )
+                })
                 .collect();
             assert!(new.is_empty(), "{source}\n{}", d.render_plain());
         }

@@ -76,7 +76,7 @@ impl<'a> Checker<'a> {
                 if joint_index(n).is_some() || super::header::RESERVED.contains(&n) {
                     self.error(
                         cx,
-                        "mprog::reserved_name",
+                        crate::lang::codes::RESERVED_NAME,
                         name.span,
                         format!("`{n}` cannot be redefined"),
                     )
@@ -147,7 +147,7 @@ impl<'a> Checker<'a> {
                 if n.vector {
                     self.error(
                         cx,
-                        "mprog::type_mismatch",
+                        crate::lang::codes::TYPE_MISMATCH,
                         value.span,
                         "`minimize` needs a scalar, found a vector",
                     )
@@ -175,7 +175,7 @@ impl<'a> Checker<'a> {
                     other => {
                         self.error(
                             cx,
-                            "mprog::not_a_constraint",
+                            crate::lang::codes::NOT_A_CONSTRAINT,
                             value.span,
                             format!(
                                 "a statement must be a constraint, found {}",
@@ -206,7 +206,7 @@ impl<'a> Checker<'a> {
             Some(_) => {
                 self.error(
                     cx,
-                    "mprog::bad_weight",
+                    crate::lang::codes::BAD_WEIGHT,
                     e.span,
                     "a weight must be zero or positive",
                 )
@@ -217,7 +217,7 @@ impl<'a> Checker<'a> {
             None => {
                 self.error(
                     cx,
-                    "mprog::bad_weight",
+                    crate::lang::codes::BAD_WEIGHT,
                     e.span,
                     "a weight must be a constant plain number",
                 )
@@ -277,7 +277,7 @@ impl<'a> Checker<'a> {
             other => {
                 self.error(
                     cx,
-                    "mprog::not_a_set",
+                    crate::lang::codes::NOT_A_SET,
                     set.span,
                     format!(
                         "`for` needs a list of joints or people, found {}",
@@ -296,7 +296,7 @@ impl<'a> Checker<'a> {
         if lanes > MAX_LANES {
             self.error(
                 cx,
-                "mprog::too_costly",
+                crate::lang::codes::TOO_COSTLY,
                 set.span,
                 format!("nested loops make {lanes} iterations (limit {MAX_LANES})"),
             )
@@ -334,7 +334,7 @@ impl<'a> Checker<'a> {
             other => {
                 self.error(
                     cx,
-                    "mprog::not_a_condition",
+                    crate::lang::codes::NOT_A_CONDITION,
                     cond.span,
                     format!(
                         "an `if` condition must be a comparison, found {}",
@@ -436,7 +436,7 @@ impl<'a> Checker<'a> {
                         self.b.unary(UnaryOp::OneMinus, m, span)
                     }
                     _ => {
-                        self.error(cx, "mprog::exact_equality", span, "`==` in a condition tests exact equality of real numbers")
+                        self.error(cx, crate::lang::codes::EXACT_EQUALITY, span, "`==` in a condition tests exact equality of real numbers")
                             .label("almost never true")
                             .help("test closeness instead, e.g. `abs(a - b) < 1 cm` or `dist(p, q) < 5 cm`");
                         return None;
@@ -491,7 +491,7 @@ impl<'a> Checker<'a> {
         if !self.b.nodes[error].motion {
             self.error(
                 cx,
-                "mprog::no_motion",
+                crate::lang::codes::NO_MOTION,
                 span,
                 "this constraint does not depend on the motion",
             )

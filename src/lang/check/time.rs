@@ -84,8 +84,13 @@ impl<'a> Checker<'a> {
                 };
                 let k = if *op == BinOp::Div {
                     if k == 0.0 {
-                        self.error(cx, "mprog::division_by_zero", e.span, "division by zero")
-                            .help("divide by a non-zero number");
+                        self.error(
+                            cx,
+                            crate::lang::codes::DIVISION_BY_ZERO,
+                            e.span,
+                            "division by zero",
+                        )
+                        .help("divide by a non-zero number");
                         return None;
                     }
                     1.0 / k
@@ -119,7 +124,7 @@ impl<'a> Checker<'a> {
     fn not_a_time(&mut self, e: &Expr, cx: &Cx, what: &str) {
         self.error(
             cx,
-            "mprog::not_a_time",
+            crate::lang::codes::NOT_A_TIME,
             e.span,
             format!("expected a time position, found {what}"),
         )
@@ -139,7 +144,7 @@ impl<'a> Checker<'a> {
         }
         self.error(
             cx,
-            "mprog::time_out_of_range",
+            crate::lang::codes::TIME_OUT_OF_RANGE,
             span,
             format!("frame {f} is outside the motion"),
         )
@@ -162,7 +167,7 @@ impl<'a> Checker<'a> {
             } else {
                 format!("frames {fa}..{fb} leave the motion")
             };
-            self.error(cx, "mprog::time_out_of_range", span, format!("the range {why}"))
+            self.error(cx, crate::lang::codes::TIME_OUT_OF_RANGE, span, format!("the range {why}"))
                 .label("bad range")
                 .help(format!(
                     "`during a..b` covers frames a ≤ t < b with 0 ≤ a < b ≤ {len} (the length); `during 0%..100%` is all of it"

@@ -65,7 +65,7 @@ fn check_limits(source: &str) -> Option<Diagnostic> {
     if source.len() > MAX_SOURCE_BYTES {
         return Some(
             Diagnostic::error(
-                "mprog::too_large",
+                crate::lang::codes::TOO_LARGE,
                 Span::new(0, 0),
                 format!(
                     "the program is {} bytes; the limit is {MAX_SOURCE_BYTES}",
@@ -93,7 +93,7 @@ fn check_limits(source: &str) -> Option<Diagnostic> {
                 if depth > MAX_BRACKET_DEPTH {
                     return Some(
                         Diagnostic::error(
-                            "mprog::too_deep",
+                            crate::lang::codes::TOO_DEEP,
                             Span::new(i, i + 1),
                             format!(
                                 "brackets are nested more than {MAX_BRACKET_DEPTH} levels deep"
@@ -187,7 +187,7 @@ fn syntax_error(e: pest::error::Error<Rule>, source: &str) -> Diagnostic {
     } else {
         end
     };
-    let mut d = Diagnostic::error("mprog::syntax", Span::new(start, end), message);
+    let mut d = Diagnostic::error(crate::lang::codes::SYNTAX, Span::new(start, end), message);
     if !expected.is_empty() {
         d = d.label(format!("expected {expected}"));
     }
@@ -440,7 +440,7 @@ impl Builder<'_> {
             if depth == MAX_EXPR_DEPTH + 1 {
                 self.diags.borrow_mut().push(
                     Diagnostic::error(
-                        "mprog::too_deep",
+                        crate::lang::codes::TOO_DEEP,
                         e.span,
                         format!("expression nested more than {MAX_EXPR_DEPTH} levels deep"),
                     )
@@ -546,8 +546,12 @@ impl Builder<'_> {
                     Some(v) if v.is_finite() => leaf(ExprKind::Number(v, unit)),
                     _ => {
                         self.diags.borrow_mut().push(
-                            Diagnostic::error("mprog::bad_number", span, "number out of range")
-                                .help("write a finite number such as `1.5` or `2e3`"),
+                            Diagnostic::error(
+                                crate::lang::codes::BAD_NUMBER,
+                                span,
+                                "number out of range",
+                            )
+                            .help("write a finite number such as `1.5` or `2e3`"),
                         );
                         leaf(ExprKind::Error)
                     }
