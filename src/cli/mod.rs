@@ -14,6 +14,7 @@ pub mod io;
 pub mod repl;
 pub mod run;
 pub mod score;
+pub mod take;
 pub mod train;
 pub mod view;
 
