@@ -27,7 +27,7 @@ use mprog::motion::Motion;
 use mprog::solve::take::frames_of;
 use mprog::solve::{
     DEFAULT_BLEND, DEFAULT_STRENGTH, Edit, GuideConfig, Prior, SolveRequest, Solver, Take,
-    hold_weights, solve,
+    hold_weights, in_between_hold, solve,
 };
 use std::path::PathBuf;
 
@@ -163,47 +163,35 @@ fn editing_a_real_walk() {
     save("take", std::slice::from_ref(&retargeted));
     let mut rows = vec![measure("take (strength 0)", &retargeted, &retargeted, &program)];
     let mut at_default = None;
-    for s in [0.3, 0.5, 0.7, 1.0] {
+    let guide = || Solver::new(GuideConfig::default());
+    // (label, solver, strength, kept frames, path held)
+    let runs: Vec<(String, Solver, f32, Vec<std::ops::Range<usize>>, bool)> = vec![
+        ("guide".into(), guide(), 0.3, vec![], false),
+        ("guide".into(), guide(), 0.5, vec![], false),
+        ("guide, --keep-path".into(), guide(), 0.3, vec![], true),
+        ("guide, --keep-path".into(), guide(), 0.5, vec![], true),
+        ("guide, --keep-path".into(), guide(), 0.7, vec![], true),
+        ("guide, --keep-path".into(), guide(), 1.0, vec![], true),
+        (format!("guide, --keep-path --keep ..{}", n / 2 - 10), guide(), 0.5, vec![0..n / 2 - 10], true),
+        (format!("guide, --keep ..{}", n / 2), guide(), 0.5, vec![0..n / 2], false),
+        ("plain (unguided), --keep-path".into(), Solver::plain(SamplerKind::Ddpm(1000)), 0.5, vec![], true),
+    ];
+    for (i, (label, solver, s, keep, path)) in runs.into_iter().enumerate() {
         let e = Edit {
             take: take.clone(),
             strength: s,
-            hold: Vec::new(),
+            hold: if keep.is_empty() { Vec::new() } else { hold_weights(n, &keep, DEFAULT_BLEND) },
+            hold_path: path,
         };
-        let m = edit_once(&bundle, &program, prompt, Solver::new(GuideConfig::default()), e);
-        save(&format!("edit_s{s}"), std::slice::from_ref(&m));
-        let row = measure(&format!("guide, strength {s}"), &retargeted, &m, &program);
-        if s == DEFAULT_STRENGTH {
+        let default = s == DEFAULT_STRENGTH && path && keep.is_empty() && label.starts_with("guide");
+        let m = edit_once(&bundle, &program, prompt, solver, e);
+        save(&format!("edit_{i}"), std::slice::from_ref(&m));
+        let row = measure(&format!("{label}, strength {s} (edit_{i})"), &retargeted, &m, &program);
+        if default {
             at_default = Some(measure("default", &retargeted, &m, &program));
         }
         rows.push(row);
     }
-    for s in [0.5, 1.0] {
-        let e = Edit {
-            take: take.clone(),
-            strength: s,
-            hold: hold_weights(n, &[0..n / 2], DEFAULT_BLEND),
-        };
-        let m = edit_once(&bundle, &program, prompt, Solver::new(GuideConfig::default()), e);
-        save(&format!("edit_keep_s{s}"), std::slice::from_ref(&m));
-        rows.push(measure(
-            &format!("guide, strength {s}, --keep ..{}", n / 2),
-            &retargeted,
-            &m,
-            &program,
-        ));
-    }
-    let plain = Edit {
-        take: take.clone(),
-        strength: DEFAULT_STRENGTH,
-        hold: Vec::new(),
-    };
-    let m = edit_once(&bundle, &program, prompt, Solver::plain(SamplerKind::Ddpm(1000)), plain);
-    rows.push(measure(
-        &format!("plain (unguided), strength {DEFAULT_STRENGTH}"),
-        &retargeted,
-        &m,
-        &program,
-    ));
     print(&rows);
     let r = at_default.expect("the default strength is measured");
     assert!(r.root_dev <= 0.2, "root path {:.3} m from the take", r.root_dev);
@@ -240,7 +228,8 @@ fn in_between_two_real_clips() {
     let edit = Edit {
         take,
         strength: 1.0,
-        hold: hold_weights(frames, &[0..context, frames - context..frames], DEFAULT_BLEND),
+        hold: in_between_hold(frames, context, DEFAULT_BLEND),
+        hold_path: false,
     };
     let none = |j: Tensor<5>| j.sum_dim(4).sum_dim(3).sum_dim(2).sum_dim(1).reshape([1]) * 0.0;
     let req = SolveRequest::new(

@@ -37,6 +37,11 @@ pub struct TakeArgs {
     /// The inverse of `--keep`: only frames `a..b` change; the rest is held to the take.
     #[arg(long, requires = "from", value_name = "A..B", value_parser = parse_range)]
     pub edit: Option<RangeArg>,
+    /// Hold the take's path (root position, facing and height) on every frame and edit
+    /// only the body: the model otherwise walks its own way off the take's path. Leave it
+    /// off when the program must move the path.
+    #[arg(long, requires = "from", conflicts_with = "to")]
+    pub keep_path: bool,
     /// Frames over which a kept window blends into the edited one at each seam.
     #[arg(long, requires = "from", value_name = "FRAMES", default_value_t = DEFAULT_BLEND)]
     pub blend: usize,
@@ -116,6 +121,8 @@ pub struct TakePlan {
     pub frames: usize,
     /// Blend frames at each seam.
     pub blend: usize,
+    /// Hold the take's path on every frame.
+    pub keep_path: bool,
     /// Provenance for the outputs' meta.
     pub meta: Meta,
 }
@@ -225,6 +232,7 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
     meta.insert("kept_frames".into(), ranges_json(&keep));
     meta.insert("edited_frames".into(), ranges_json(&complement(&keep, frames)));
     meta.insert("blend".into(), args.blend.into());
+    meta.insert("keep_path".into(), args.keep_path.into());
     Ok(Some(TakePlan {
         people,
         after: None,
@@ -232,6 +240,7 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
         keep,
         frames,
         blend: args.blend,
+        keep_path: args.keep_path,
         meta,
     }))
 }
@@ -280,7 +289,16 @@ fn plan_between(
         .iter()
         .map(|m| frames_of(m, 0, c + 1).expect("checked length"))
         .collect();
-    let keep = vec![0..c, frames - c..frames];
+    if c <= args.blend {
+        return Err(miette!(
+            help = "raise --context or lower --blend",
+            "--context {c} is not longer than --blend {}: an in-between blends inside the frames it keeps",
+            args.blend
+        ));
+    }
+    // The blend eases out inside the kept frames: the gap has no take to blend towards.
+    let inner = c - args.blend;
+    let keep = vec![0..inner, frames - inner..frames];
     meta.insert("to".into(), to.display().to_string().into());
     meta.insert("to_sha256".into(), hash.into());
     meta.insert("context".into(), c.into());
@@ -295,6 +313,7 @@ fn plan_between(
         keep,
         frames,
         blend: args.blend,
+        keep_path: false,
         meta,
     })
 }
@@ -344,8 +363,10 @@ impl TakePlan {
             hold: if self.keep.is_empty() {
                 Vec::new()
             } else {
+                // An in-between's kept ranges already stop `blend` short of the gap.
                 hold_weights(self.frames, &self.keep, self.blend)
             },
+            hold_path: self.keep_path,
         })
     }
 }

@@ -507,6 +507,7 @@ fn take_edit(take: &CurrentMotion, strength: f32) -> Result<Edit, String> {
         take,
         strength,
         hold: Vec::new(),
+        hold_path: false,
     })
 }
 

@@ -13,6 +13,9 @@
 //!   kept frames come back exactly (the skeleton projection of `guide`'s late steps
 //!   touches every frame).
 //!
+//! * **The path.** [`Edit::hold_path`] holds the take's root columns on every frame the
+//!   same way, so the body is edited on the take's own path.
+//!
 //! Kept frames keep their features: pose, velocities and contacts. The root is stored as
 //! velocities, so frames kept after an edited window follow on from where the edit leaves
 //! the body (MDM's in-betweening does the same); frames kept before it stay in place.
@@ -48,7 +51,16 @@ pub struct Edit {
     /// Per frame, how firmly the frame is held to the take (1: kept, 0: free); empty when
     /// no frame is kept. Build it with [`hold_weights`].
     pub hold: Vec<f32>,
+    /// Hold the take's path on every frame: the root columns (turning speed, horizontal
+    /// velocity, height) stay the take's while the pose is edited, as MDM holds the root
+    /// in its body-part editing. The model walks off the take's path when it re-denoises
+    /// it (a real walk drifted 0.9–2.5 m sideways in 7 s); a program that must move the
+    /// path ("go around the pillar") leaves this off.
+    pub hold_path: bool,
 }
+
+/// Root columns of a feature row: turning speed, horizontal velocity, height.
+const PATH_COLUMNS: usize = 4;
 
 /// Per-frame hold weights of `frames` frames: 1 on every frame of `keep`, falling linearly
 /// over `blend` frames into the frames next to them (the seams), 0 elsewhere.
@@ -71,6 +83,14 @@ pub fn hold_weights(frames: usize, keep: &[Range<usize>], blend: usize) -> Vec<f
         }
     }
     w
+}
+
+/// Hold weights of an in-between `frames` long that keeps `context` frames at each end:
+/// the blend lies inside the kept frames (the gap has no take to blend towards), so the
+/// outer `context − blend` frames are exact and the next `blend` ease into the gap.
+pub fn in_between_hold(frames: usize, context: usize, blend: usize) -> Vec<f32> {
+    let inner = context.saturating_sub(blend);
+    hold_weights(frames, &[0..inner, frames - inner..frames], blend)
 }
 
 impl Edit {
@@ -123,7 +143,7 @@ pub struct EditState {
     take: Tensor<3>,
     /// `[B·P, N, 263]` hold weights (`None`: nothing kept).
     hold: Option<Tensor<3>>,
-    /// Per frame `1 − w`, the share of a step a frame takes.
+    /// `[N, 263]` `1 − w`, the share of a step each frame's feature takes (empty: all 1).
     free: Vec<f32>,
 }
 
@@ -145,15 +165,21 @@ impl EditState {
         let motions = samples * edit.take.features.len();
         let dims = [motions, n, FEATURE_DIM];
         let take = Tensor::from_data(TensorData::new(x, dims), device);
-        let hold = (!edit.hold.is_empty()).then(|| {
-            Tensor::<3>::from_data(TensorData::new(edit.hold.clone(), [1, n, 1]), device)
+        let held = !edit.hold.is_empty() || edit.hold_path;
+        // `[N, 263]`: the frame's weight, 1 on the path columns when the path is held.
+        let weights: Vec<f32> = (0..if held { n } else { 0 })
+            .flat_map(|t| {
+                let w = edit.hold.get(t).copied().unwrap_or(0.0);
+                (0..FEATURE_DIM).map(move |c| {
+                    if edit.hold_path && c < PATH_COLUMNS { 1.0 } else { w }
+                })
+            })
+            .collect();
+        let free = weights.iter().map(|w| 1.0 - w).collect();
+        let hold = held.then(|| {
+            Tensor::<3>::from_data(TensorData::new(weights, [1, n, FEATURE_DIM]), device)
                 .expand(dims)
         });
-        let free = if edit.hold.is_empty() {
-            Vec::new()
-        } else {
-            edit.hold.iter().map(|w| 1.0 - w).collect()
-        };
         EditState {
             strength: edit.strength,
             take,
@@ -197,17 +223,17 @@ impl Ctx<'_> {
         self.hold_x0(x)
     }
 
-    /// Scales a step (or gradient) over `[B·P, N, width]` rows by each frame's `1 − w`, so
-    /// kept frames do not move and seams move partly.
+    /// Scales a step (or gradient) over `[B·P, N, width]` rows (the first `width` columns
+    /// of the features) by each feature's `1 − w`, so kept frames and a held path do not
+    /// move and seams move partly.
     pub fn hold_step(&self, v: &mut [f32], width: usize) {
         let Some(free) = self.edit.as_ref().map(|e| &e.free).filter(|f| !f.is_empty()) else {
             return;
         };
         for (k, row) in v.chunks_exact_mut(width).enumerate() {
-            let s = free[k % self.frames];
-            if s != 1.0 {
-                row.iter_mut().for_each(|x| *x *= s);
-            }
+            let t = k % self.frames;
+            let f = &free[t * FEATURE_DIM..t * FEATURE_DIM + width];
+            row.iter_mut().zip(f).for_each(|(x, s)| *x *= s);
         }
     }
 
@@ -263,6 +289,12 @@ mod tests {
         let want = [1.0, 1.0, 1.0, 2.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 2.0 / 3.0, 1.0, 1.0, 1.0];
         assert!(w.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6), "{w:?}");
         assert!(hold_weights(5, &[], 3).iter().all(|v| *v == 0.0));
+        // An in-between blends inside its context: frame 4 and 5 of 6 ease out, the gap
+        // (frames 6..14) is free.
+        let w = in_between_hold(20, 6, 2);
+        assert_eq!(&w[..4], &[1.0; 4]);
+        assert!(w[4] > w[5] && w[5] > 0.0 && w[6..14].iter().all(|v| *v == 0.0), "{w:?}");
+        assert_eq!(&w[16..], &[1.0; 4]);
         // Blend 0: a hard switch.
         assert_eq!(hold_weights(4, &[1..2], 0), vec![0.0, 1.0, 0.0, 0.0]);
     }

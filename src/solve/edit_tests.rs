@@ -36,6 +36,7 @@ fn edit(strength: f32, hold: Vec<f32>) -> Edit {
         take: Take::encode(&[take_walk()]).unwrap(),
         strength,
         hold,
+        hold_path: false,
     }
 }
 
@@ -140,6 +141,28 @@ fn strength_sets_how_much_of_the_chain_runs() {
         .unwrap();
         assert_eq!(reports.len(), steps, "strength {s}");
         assert!(reports.iter().all(|&(_, total)| total == steps));
+    }
+}
+
+#[test]
+fn a_held_path_is_the_takes_and_the_pose_is_edited() {
+    let e = Edit {
+        hold_path: true,
+        ..edit(0.7, Vec::new())
+    };
+    let r = solve_ok(&request(guide(), e.clone()));
+    let take = &e.take.features[0];
+    let mut path_gap = 0.0f32;
+    for (row, want) in r.features.chunks_exact(FEATURE_DIM).zip(take.chunks_exact(FEATURE_DIM)) {
+        for c in 0..4 {
+            path_gap = path_gap.max((row[c] - want[c]).abs());
+        }
+    }
+    assert!(path_gap < 1e-4, "the path moved by {path_gap}");
+    assert!(row_gap(&r.features, take, 0..N) > 1e-2, "the pose was not edited");
+    let want = e.take.motions().unwrap();
+    for (a, b) in r.motions[0][0].frames.iter().zip(&want[0].frames) {
+        assert!((a[0] - b[0]).length() < 1e-3, "root {} vs {}", a[0], b[0]);
     }
 }
 
