@@ -56,7 +56,9 @@ fn take(dir: &Path, name: &str, frames: usize, people: usize) -> (String, Vec<Mo
 
 fn people_of(path: &Path) -> (Vec<Motion>, Meta) {
     match read_motion(path).unwrap() {
-        LoadedMotion::Joints { people, meta } => (people.into_iter().map(|p| p.motion).collect(), meta),
+        LoadedMotion::Joints { people, meta } => {
+            (people.into_iter().map(|p| p.motion).collect(), meta)
+        }
         LoadedMotion::Features(_) => panic!("joints expected"),
     }
 }
@@ -68,7 +70,14 @@ fn strength_zero_returns_the_take_with_its_provenance() {
     let (take_path, people) = take(dir.path(), "take.json", 41, 1);
     let out_path = dir.path().join("out.json");
     let out = run(&[
-        "run", &prog, "--from", &take_path, "--strength", "0", "--no-baseline", "-o",
+        "run",
+        &prog,
+        "--from",
+        &take_path,
+        "--strength",
+        "0",
+        "--no-baseline",
+        "-o",
         out_path.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -93,8 +102,22 @@ fn kept_frames_come_back_and_the_rest_is_edited() {
     let (take_path, people) = take(dir.path(), "take.json", 41, 1);
     let out_path = dir.path().join("out.json");
     let out = run(&[
-        "run", &prog, "--from", &take_path, "--strength", "1", "--keep", "..20", "--knob",
-        "steps=10", "--knob", "k_late=20", "--knob", "late_steps=2", "--no-baseline", "-o",
+        "run",
+        &prog,
+        "--from",
+        &take_path,
+        "--strength",
+        "1",
+        "--keep",
+        "..20",
+        "--knob",
+        "steps=10",
+        "--knob",
+        "k_late=20",
+        "--knob",
+        "late_steps=2",
+        "--no-baseline",
+        "-o",
         out_path.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -130,15 +153,39 @@ fn bad_takes_windows_and_strengths_are_clear_errors_with_no_output() {
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec![&prog, "--from", &missing], "cannot read the take"),
         (vec![&prog, "--from", &garbage], "cannot read the take"),
-        (vec![&two, "--from", &one], "holds 1 person; the program has 2"),
-        (vec![&prog, "--from", &one, "--strength", "1.5"], "outside 0…1"),
-        (vec![&prog, "--from", &one, "--strength", "-0.2"], "outside 0…1"),
-        (vec![&prog, "--from", &one, "--keep", "30..50"], "outside the take"),
-        (vec![&prog, "--from", &one, "--edit", "10..41"], "outside the take"),
-        (vec![&prog, "--from", &long], "edits at most"),
-        (vec![&prog, "--from", &long, "--take-frames", "250..400"], "outside the take"),
-        (vec![&prog, "--from", &one, "--to", &one, "--context", "20"], "leaves no gap"),
-        (vec![&prog, "--from", &one, "--solver", "latent"], "cannot edit a take"),
+        (
+            vec![&two, "--from", &one],
+            "holds 1 person; the program has 2",
+        ),
+        (
+            vec![&prog, "--from", &one, "--strength", "1.5"],
+            "outside 0…1",
+        ),
+        (
+            vec![&prog, "--from", &one, "--strength", "-0.2"],
+            "outside 0…1",
+        ),
+        (
+            vec![&prog, "--from", &one, "--keep", "30..50"],
+            "outside the take",
+        ),
+        (
+            vec![&prog, "--from", &one, "--edit", "10..41"],
+            "outside the take",
+        ),
+        (vec![&prog, "--from", &long], "gives 299 frames"),
+        (
+            vec![&prog, "--from", &long, "--take-frames", "250..400"],
+            "outside the take",
+        ),
+        (
+            vec![&prog, "--from", &one, "--to", &one, "--context", "20"],
+            "leaves no gap",
+        ),
+        (
+            vec![&prog, "--from", &one, "--solver", "latent"],
+            "cannot edit a take",
+        ),
         (vec![&prog, "--strength", "0.5"], "--from"),
     ];
     for (args, want) in cases {

@@ -391,8 +391,14 @@ fn run_edits_the_take_loaded_with_motion() {
     assert!(loaded.contains("edits this take"), "{loaded}");
     // Strength 0 returns the take, retargeted: 40 frames give 39, where the take stood.
     let out = say(&mut s, ":run plain strength=0");
-    assert!(out.contains("editing") && out.contains("39 frames"), "{out}");
-    let want = mprog::solve::Take::encode(&[walk()]).unwrap().motions().unwrap();
+    assert!(
+        out.contains("editing") && out.contains("39 frames"),
+        "{out}"
+    );
+    let want = mprog::solve::Take::encode(&[walk()])
+        .unwrap()
+        .motions()
+        .unwrap();
     let got = &s.motion().unwrap().people[0];
     for (a, b) in got.frames.iter().zip(&want[0].frames) {
         assert!(a.iter().zip(b).all(|(p, q)| (*p - *q).length() < 1e-4));
@@ -400,6 +406,9 @@ fn run_edits_the_take_loaded_with_motion() {
     assert!(fails(&mut s, ":run plain strength=1.5").contains("outside 0…1"));
     assert!(fails(&mut s, ":run latent strength=0.5").contains("cannot edit a take"));
     // A short edited chain runs, and `:gen` would end the editing.
-    let out = say(&mut s, ":run guide 2 steps=10 k_late=20 late_steps=2 strength=0.5");
+    let out = say(
+        &mut s,
+        ":run guide 2 steps=10 k_late=20 late_steps=2 strength=0.5",
+    );
     assert!(out.contains("at strength 0.5"), "{out}");
 }

@@ -28,7 +28,12 @@ pub struct TakeArgs {
     #[arg(long, value_name = "TAKE")]
     pub from: Option<PathBuf>,
     /// 0…1: how much of the take the model may change (0 returns the take, 1 ignores it).
-    #[arg(long, requires = "from", value_name = "S")]
+    #[arg(
+        long,
+        requires = "from",
+        value_name = "S",
+        allow_negative_numbers = true
+    )]
     pub strength: Option<f32>,
     /// Frames `a..b` (`a..`, `..b`) held to the take at every step (in-painting);
     /// repeatable.
@@ -129,23 +134,26 @@ pub struct TakePlan {
 
 /// SHA-256 of a file, hex.
 fn sha256(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| miette!("cannot read the take {}: {e}", path.display()))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| miette!("cannot read the take {}: {e}", path.display()))?;
     Ok(format!("{:x}", Sha256::digest(&bytes)))
 }
 
 /// The people of a take file, with its hash.
 fn read_take(path: &Path, people: usize) -> Result<(Vec<Motion>, String)> {
     let hash = sha256(path)?;
-    let loaded = read_motion(path)
-        .map_err(|e| miette!("cannot read the take {}: {e}", path.display()))?;
+    let loaded =
+        read_motion(path).map_err(|e| miette!("cannot read the take {}: {e}", path.display()))?;
     let motions: Vec<Motion> = match loaded {
         LoadedMotion::Joints { people, .. } => people.into_iter().map(|p| p.motion).collect(),
-        LoadedMotion::Features(array) => vec![
-            mprog::features::recover_from_ric(&array.data).map_err(|e| {
-                miette!("cannot read the take {}: HumanML3D features: {e}", path.display())
-            })?,
-        ],
+        LoadedMotion::Features(array) => {
+            vec![mprog::features::recover_from_ric(&array.data).map_err(|e| {
+                miette!(
+                    "cannot read the take {}: HumanML3D features: {e}",
+                    path.display()
+                )
+            })?]
+        }
     };
     if motions.len() != people {
         return Err(miette!(
@@ -153,7 +161,11 @@ fn read_take(path: &Path, people: usize) -> Result<(Vec<Motion>, String)> {
             "the take {} holds {} {}; the program has {people}",
             path.display(),
             motions.len(),
-            if motions.len() == 1 { "person" } else { "people" },
+            if motions.len() == 1 {
+                "person"
+            } else {
+                "people"
+            },
         ));
     }
     let frames = motions.iter().map(Motion::len).min().unwrap_or(0);
@@ -199,12 +211,18 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
             .iter()
             .map(|m| frames_of(m, window.start, window.end).expect("checked range"))
             .collect();
-        meta.insert("take_frames".into(), serde_json::json!([window.start, window.end]));
+        meta.insert(
+            "take_frames".into(),
+            serde_json::json!([window.start, window.end]),
+        );
     }
     let frames = people[0].len() - 1;
     if frames > max_frames {
         return Err(miette!(
-            help = format!("pick a part with --take-frames a..b (at most {} frames)", max_frames + 1),
+            help = format!(
+                "pick a part with --take-frames a..b (at most {} frames)",
+                max_frames + 1
+            ),
             "the take {} gives {frames} frames; this model edits at most {max_frames}",
             from.display()
         ));
@@ -230,7 +248,10 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
     }
     meta.insert("strength".into(), f64::from(strength).into());
     meta.insert("kept_frames".into(), ranges_json(&keep));
-    meta.insert("edited_frames".into(), ranges_json(&complement(&keep, frames)));
+    meta.insert(
+        "edited_frames".into(),
+        ranges_json(&complement(&keep, frames)),
+    );
     meta.insert("blend".into(), args.blend.into());
     meta.insert("keep_path".into(), args.keep_path.into());
     Ok(Some(TakePlan {
@@ -269,12 +290,16 @@ fn plan_between(
             "--context {c} leaves no gap: the in-between is {frames} frames (the program's length) and keeps {c} at each end"
         ));
     }
-    for (flag, path, people) in [("--from", &args.from, &before), ("--to", &Some(to.to_path_buf()), &after)] {
+    for (flag, path, people) in [
+        ("--from", &args.from, &before),
+        ("--to", &Some(to.to_path_buf()), &after),
+    ] {
         if people[0].len() < c + 1 {
             return Err(miette!(
                 help = "lower --context",
                 "{flag} {}: {} frames; an in-between keeping {c} frames of it needs {}",
-                path.as_ref().map_or(String::new(), |p| p.display().to_string()),
+                path.as_ref()
+                    .map_or(String::new(), |p| p.display().to_string()),
                 people[0].len(),
                 c + 1
             ));
@@ -304,7 +329,10 @@ fn plan_between(
     meta.insert("context".into(), c.into());
     meta.insert("strength".into(), 1.0.into());
     meta.insert("kept_frames".into(), ranges_json(&keep));
-    meta.insert("edited_frames".into(), ranges_json(&complement(&keep, frames)));
+    meta.insert(
+        "edited_frames".into(),
+        ranges_json(&complement(&keep, frames)),
+    );
     meta.insert("blend".into(), args.blend.into());
     Ok(TakePlan {
         people: before,
@@ -372,6 +400,8 @@ impl TakePlan {
 }
 
 #[cfg(test)]
+// A list of one frame range is what `complement` takes, not a range to collect.
+#[allow(clippy::single_range_in_vec_init)]
 mod tests {
     use super::*;
 
@@ -379,12 +409,34 @@ mod tests {
     fn ranges_parse_and_resolve() {
         let r = parse_range("10..20").unwrap();
         assert_eq!(r.resolve("--keep", 30, "x").unwrap(), 10..20);
-        assert_eq!(parse_range("..5").unwrap().resolve("--keep", 30, "x").unwrap(), 0..5);
-        assert_eq!(parse_range("25..").unwrap().resolve("--keep", 30, "x").unwrap(), 25..30);
+        assert_eq!(
+            parse_range("..5")
+                .unwrap()
+                .resolve("--keep", 30, "x")
+                .unwrap(),
+            0..5
+        );
+        assert_eq!(
+            parse_range("25..")
+                .unwrap()
+                .resolve("--keep", 30, "x")
+                .unwrap(),
+            25..30
+        );
         assert!(parse_range("5").is_err());
         assert!(parse_range("a..3").is_err());
-        assert!(parse_range("10..40").unwrap().resolve("--keep", 30, "x").is_err());
-        assert!(parse_range("9..9").unwrap().resolve("--keep", 30, "x").is_err());
+        assert!(
+            parse_range("10..40")
+                .unwrap()
+                .resolve("--keep", 30, "x")
+                .is_err()
+        );
+        assert!(
+            parse_range("9..9")
+                .unwrap()
+                .resolve("--keep", 30, "x")
+                .is_err()
+        );
         assert_eq!(complement(&[0..3, 7..10], 10), vec![3..7]);
         assert_eq!(complement(&[2..4], 6), vec![0..2, 4..6]);
     }

@@ -324,9 +324,7 @@ impl Session {
         };
         let edit = match (&self.take, strength) {
             (None, Some(_)) => {
-                return Reply::error(
-                    "`strength` edits a take: load one with `:motion FILE` first",
-                );
+                return Reply::error("`strength` edits a take: load one with `:motion FILE` first");
             }
             (None, None) => None,
             (Some(take), s) => match take_edit(take, s.unwrap_or(DEFAULT_STRENGTH)) {
@@ -335,13 +333,17 @@ impl Session {
             },
         };
         let frames = edit.as_ref().map_or(program.length(), |e| e.take.frames);
-        let mut req = SolveRequest::new(prompts, frames, seed, solver.clone())
-            .placed(program.placements());
+        let mut req =
+            SolveRequest::new(prompts, frames, seed, solver.clone()).placed(program.placements());
         let origin = match (edit, &self.take) {
             (Some(e), Some(take)) => {
                 let s = e.strength;
                 req = req.editing(e);
-                format!(":run {} seed {seed} editing {} at strength {s}", solver.name(), take.origin)
+                format!(
+                    ":run {} seed {seed} editing {} at strength {s}",
+                    solver.name(),
+                    take.origin
+                )
             }
             _ => format!(":run {} seed {seed}", solver.name()),
         };
@@ -499,7 +501,9 @@ impl Session {
 /// `mprog run --keep`'s).
 fn take_edit(take: &CurrentMotion, strength: f32) -> Result<Edit, String> {
     if !(strength.is_finite() && (0.0..=1.0).contains(&strength)) {
-        return Err(format!("strength {strength} is outside 0…1 (0 returns the take, 1 ignores it)"));
+        return Err(format!(
+            "strength {strength} is outside 0…1 (0 returns the take, 1 ignores it)"
+        ));
     }
     let take = Take::encode(&take.people)
         .map_err(|e| format!("cannot encode the take {}: {e}", take.origin))?;

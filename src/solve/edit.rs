@@ -28,9 +28,7 @@ use super::request::{Phase, Progress};
 use super::run::Ctx;
 use super::take::Take;
 use crate::features::FEATURE_DIM;
-use crate::model::sampler::{
-    SamplerKind, ddim_step, guided_x0, posterior_mean, schedule_for,
-};
+use crate::model::sampler::{SamplerKind, ddim_step, guided_x0, posterior_mean, schedule_for};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use burn::prelude::*;
 use std::ops::Range;
@@ -154,12 +152,11 @@ impl EditState {
         let mut x = Vec::with_capacity(samples * edit.take.features.len() * n * FEATURE_DIM);
         for _ in 0..samples {
             for f in &edit.take.features {
-                x.extend(f.chunks_exact(FEATURE_DIM).flat_map(|row| {
-                    row.iter()
-                        .zip(mean)
-                        .zip(std)
-                        .map(|((v, m), s)| (v - m) / s)
-                }));
+                x.extend(
+                    f.chunks_exact(FEATURE_DIM).flat_map(|row| {
+                        row.iter().zip(mean).zip(std).map(|((v, m), s)| (v - m) / s)
+                    }),
+                );
             }
         }
         let motions = samples * edit.take.features.len();
@@ -171,7 +168,11 @@ impl EditState {
             .flat_map(|t| {
                 let w = edit.hold.get(t).copied().unwrap_or(0.0);
                 (0..FEATURE_DIM).map(move |c| {
-                    if edit.hold_path && c < PATH_COLUMNS { 1.0 } else { w }
+                    if edit.hold_path && c < PATH_COLUMNS {
+                        1.0
+                    } else {
+                        w
+                    }
                 })
             })
             .collect();
@@ -227,7 +228,12 @@ impl Ctx<'_> {
     /// of the features) by each feature's `1 − w`, so kept frames and a held path do not
     /// move and seams move partly.
     pub fn hold_step(&self, v: &mut [f32], width: usize) {
-        let Some(free) = self.edit.as_ref().map(|e| &e.free).filter(|f| !f.is_empty()) else {
+        let Some(free) = self
+            .edit
+            .as_ref()
+            .map(|e| &e.free)
+            .filter(|f| !f.is_empty())
+        else {
             return;
         };
         for (k, row) in v.chunks_exact_mut(width).enumerate() {
@@ -239,7 +245,11 @@ impl Ctx<'_> {
 
     /// The unguided chain of `kind` over the edit (started at its strength, kept frames
     /// held); [`Ctx::sample_plain`] without a take.
-    pub fn sample_edited(&self, kind: SamplerKind, progress: &mut dyn FnMut(Progress)) -> Tensor<3> {
+    pub fn sample_edited(
+        &self,
+        kind: SamplerKind,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Tensor<3> {
         if self.edit.is_none() {
             return self.sample_plain(kind, progress);
         }
@@ -275,6 +285,8 @@ impl Ctx<'_> {
 }
 
 #[cfg(test)]
+// A list of one frame range is what `hold_weights` takes, not a range to collect.
+#[allow(clippy::single_range_in_vec_init)]
 mod tests {
     use super::*;
 
@@ -286,14 +298,31 @@ mod tests {
         assert!(w[7..].iter().all(|v| *v == 0.0));
         // Two windows: an in-between holds both ends; ramps never exceed 1 nor overlap badly.
         let w = hold_weights(10, &[0..3, 7..10], 2);
-        let want = [1.0, 1.0, 1.0, 2.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 2.0 / 3.0, 1.0, 1.0, 1.0];
-        assert!(w.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6), "{w:?}");
+        let want = [
+            1.0,
+            1.0,
+            1.0,
+            2.0 / 3.0,
+            1.0 / 3.0,
+            1.0 / 3.0,
+            2.0 / 3.0,
+            1.0,
+            1.0,
+            1.0,
+        ];
+        assert!(
+            w.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6),
+            "{w:?}"
+        );
         assert!(hold_weights(5, &[], 3).iter().all(|v| *v == 0.0));
         // An in-between blends inside its context: frame 4 and 5 of 6 ease out, the gap
         // (frames 6..14) is free.
         let w = in_between_hold(20, 6, 2);
         assert_eq!(&w[..4], &[1.0; 4]);
-        assert!(w[4] > w[5] && w[5] > 0.0 && w[6..14].iter().all(|v| *v == 0.0), "{w:?}");
+        assert!(
+            w[4] > w[5] && w[5] > 0.0 && w[6..14].iter().all(|v| *v == 0.0),
+            "{w:?}"
+        );
         assert_eq!(&w[16..], &[1.0; 4]);
         // Blend 0: a hard switch.
         assert_eq!(hold_weights(4, &[1..2], 0), vec![0.0, 1.0, 0.0, 0.0]);

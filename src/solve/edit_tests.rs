@@ -2,6 +2,9 @@
 //! is a solve without one, kept frames come back exactly, solvers that cannot edit say so,
 //! and bad edits are refused.
 
+// A list of one frame range is what `hold_weights` takes, not a range to collect.
+#![allow(clippy::single_range_in_vec_init)]
+
 use super::tests::{tiny_bundle, wrist_up};
 use super::*;
 use crate::features::FEATURE_DIM;
@@ -25,7 +28,9 @@ fn take_walk() -> Motion {
                 p[20].z += 2.0 * swing;
                 p[19].z -= swing;
                 p[21].z -= 2.0 * swing;
-                p.map(|v| turn * (v + Vec3::new(0.0, 0.0, 0.04 * t as f32)) + Vec3::new(1.0, 0.0, -2.0))
+                p.map(|v| {
+                    turn * (v + Vec3::new(0.0, 0.0, 0.04 * t as f32)) + Vec3::new(1.0, 0.0, -2.0)
+                })
             })
             .collect(),
     )
@@ -55,8 +60,14 @@ fn request(solver: Solver, e: Edit) -> SolveRequest {
 
 fn solve_ok(req: &SolveRequest) -> SolveResult {
     let bundle = tiny_bundle();
-    solve(&Prior::from_bundle(&bundle), req, &wrist_up, &Device::flex(), |_| {})
-        .unwrap_or_else(|e| panic!("{}: {e}", req.solver.name()))
+    solve(
+        &Prior::from_bundle(&bundle),
+        req,
+        &wrist_up,
+        &Device::flex(),
+        |_| {},
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", req.solver.name()))
 }
 
 /// Largest difference between two feature rows ranges (de-normalised).
@@ -70,7 +81,10 @@ fn row_gap(a: &[f32], b: &[f32], rows: std::ops::Range<usize>) -> f32 {
 
 #[test]
 fn strength_zero_returns_the_take() {
-    for solver in [guide(), Solver::plain(crate::model::sampler::SamplerKind::Ddpm(40))] {
+    for solver in [
+        guide(),
+        Solver::plain(crate::model::sampler::SamplerKind::Ddpm(40)),
+    ] {
         let e = edit(0.0, Vec::new());
         let want = e.take.motions().unwrap();
         let r = solve_ok(&request(solver, e.clone()));
@@ -82,7 +96,10 @@ fn strength_zero_returns_the_take() {
         }
         // The take stands where it stood: frame 0's root at (1, ·, −2).
         let root = r.motions[0][0].frames[0][0];
-        assert!((root.x - 1.0).abs() < 1e-4 && (root.z + 2.0).abs() < 1e-4, "{root}");
+        assert!(
+            (root.x - 1.0).abs() < 1e-4 && (root.z + 2.0).abs() < 1e-4,
+            "{root}"
+        );
     }
 }
 
@@ -98,7 +115,10 @@ fn strength_one_is_a_solve_without_a_take() {
 
 #[test]
 fn kept_frames_come_back_exactly_and_the_rest_is_edited() {
-    for solver in [guide(), Solver::plain(crate::model::sampler::SamplerKind::Ddim(20))] {
+    for solver in [
+        guide(),
+        Solver::plain(crate::model::sampler::SamplerKind::Ddim(20)),
+    ] {
         let name = solver.name();
         let e = edit(1.0, hold_weights(N, &[0..6], 3));
         let take_error = {
@@ -108,8 +128,14 @@ fn kept_frames_come_back_exactly_and_the_rest_is_edited() {
         };
         let r = solve_ok(&request(solver, e.clone()));
         let take = &e.take.features[0];
-        assert!(row_gap(&r.features, take, 0..6) < 1e-4, "{name}: kept frames moved");
-        assert!(row_gap(&r.features, take, 9..N) > 1e-2, "{name}: nothing edited");
+        assert!(
+            row_gap(&r.features, take, 0..6) < 1e-4,
+            "{name}: kept frames moved"
+        );
+        assert!(
+            row_gap(&r.features, take, 9..N) > 1e-2,
+            "{name}: nothing edited"
+        );
         // Kept frames before the edit stay where the take put them, in the world too.
         let want = e.take.motions().unwrap();
         for t in 0..6 {
@@ -117,7 +143,11 @@ fn kept_frames_come_back_exactly_and_the_rest_is_edited() {
             assert!(d < 1e-4, "{name}: frame {t} moved {d} m");
         }
         if name == "guide" {
-            assert!(r.error[0] < take_error, "{name}: {} vs the take's {take_error}", r.error[0]);
+            assert!(
+                r.error[0] < take_error,
+                "{name}: {} vs the take's {take_error}",
+                r.error[0]
+            );
         }
     }
 }
@@ -125,7 +155,10 @@ fn kept_frames_come_back_exactly_and_the_rest_is_edited() {
 /// The wrist error of one motion's flat joints.
 fn host_error(flat: &[f32]) -> f32 {
     let n = flat.len() / 66;
-    let j = Tensor::<5>::from_data(TensorData::new(flat.to_vec(), [1, 1, n, 22, 3]), &Device::flex());
+    let j = Tensor::<5>::from_data(
+        TensorData::new(flat.to_vec(), [1, 1, n, 22, 3]),
+        &Device::flex(),
+    );
     wrist_up(j).into_scalar::<f32>()
 }
 
@@ -133,11 +166,18 @@ fn host_error(flat: &[f32]) -> f32 {
 fn strength_sets_how_much_of_the_chain_runs() {
     let bundle = tiny_bundle();
     for (s, steps) in [(0.0, 0), (0.25, 10), (0.5, 20), (1.0, 40)] {
-        let req = request(Solver::plain(crate::model::sampler::SamplerKind::Ddpm(40)), edit(s, Vec::new()));
+        let req = request(
+            Solver::plain(crate::model::sampler::SamplerKind::Ddpm(40)),
+            edit(s, Vec::new()),
+        );
         let mut reports = Vec::new();
-        solve(&Prior::from_bundle(&bundle), &req, &wrist_up, &Device::flex(), |p| {
-            reports.push((p.done, p.total))
-        })
+        solve(
+            &Prior::from_bundle(&bundle),
+            &req,
+            &wrist_up,
+            &Device::flex(),
+            |p| reports.push((p.done, p.total)),
+        )
         .unwrap();
         assert_eq!(reports.len(), steps, "strength {s}");
         assert!(reports.iter().all(|&(_, total)| total == steps));
@@ -153,13 +193,20 @@ fn a_held_path_is_the_takes_and_the_pose_is_edited() {
     let r = solve_ok(&request(guide(), e.clone()));
     let take = &e.take.features[0];
     let mut path_gap = 0.0f32;
-    for (row, want) in r.features.chunks_exact(FEATURE_DIM).zip(take.chunks_exact(FEATURE_DIM)) {
+    for (row, want) in r
+        .features
+        .chunks_exact(FEATURE_DIM)
+        .zip(take.chunks_exact(FEATURE_DIM))
+    {
         for c in 0..4 {
             path_gap = path_gap.max((row[c] - want[c]).abs());
         }
     }
     assert!(path_gap < 1e-4, "the path moved by {path_gap}");
-    assert!(row_gap(&r.features, take, 0..N) > 1e-2, "the pose was not edited");
+    assert!(
+        row_gap(&r.features, take, 0..N) > 1e-2,
+        "the pose was not edited"
+    );
     let want = e.take.motions().unwrap();
     for (a, b) in r.motions[0][0].frames.iter().zip(&want[0].frames) {
         assert!((a[0] - b[0]).length() < 1e-3, "root {} vs {}", a[0], b[0]);
@@ -181,15 +228,27 @@ fn edits_are_deterministic() {
 fn solvers_that_cannot_edit_say_so_and_bad_edits_are_refused() {
     let bundle = tiny_bundle();
     let refused = |req: &SolveRequest| -> String {
-        match solve(&Prior::from_bundle(&bundle), req, &wrist_up, &Device::flex(), |_| {}) {
+        match solve(
+            &Prior::from_bundle(&bundle),
+            req,
+            &wrist_up,
+            &Device::flex(),
+            |_| {},
+        ) {
             Err(SolveError::Invalid(m)) => m,
             Err(e) => panic!("{e}"),
             Ok(_) => panic!("{} accepted a bad edit", req.solver.name()),
         }
     };
     for name in ["latent", "ik", "ik-reg", "lbfgs"] {
-        let m = refused(&request(Solver::by_name(name).unwrap(), edit(0.5, Vec::new())));
-        assert!(m.contains("cannot edit a take") && m.contains("guide"), "{name}: {m}");
+        let m = refused(&request(
+            Solver::by_name(name).unwrap(),
+            edit(0.5, Vec::new()),
+        ));
+        assert!(
+            m.contains("cannot edit a take") && m.contains("guide"),
+            "{name}: {m}"
+        );
     }
     for s in [-0.1, 1.5, f32::NAN] {
         let m = refused(&request(guide(), edit(s, Vec::new())));

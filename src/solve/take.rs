@@ -139,7 +139,9 @@ mod tests {
                     for (elbow, wrist) in [(18, 20), (19, 21)] {
                         p[wrist] = p[elbow] + swing * (p[wrist] - p[elbow]);
                     }
-                    p.map(|v| turn * (v + Vec3::new(0.0, 0.0, 0.04 * t as f32)) + Vec3::new(x, 0.0, z))
+                    p.map(|v| {
+                        turn * (v + Vec3::new(0.0, 0.0, 0.04 * t as f32)) + Vec3::new(x, 0.0, z)
+                    })
                 })
                 .collect(),
         )
@@ -157,7 +159,11 @@ mod tests {
             // The rest pose is HumanML3D's skeleton, so retargeting changes nothing.
             for j in 0..22 {
                 let want = b[j] - Vec3::new(0.0, floor, 0.0);
-                assert!((a[j] - want).length() < 2e-3, "frame {t} joint {j}: {} vs {want}", a[j]);
+                assert!(
+                    (a[j] - want).length() < 2e-3,
+                    "frame {t} joint {j}: {} vs {want}",
+                    a[j]
+                );
             }
         }
     }
@@ -169,7 +175,10 @@ mod tests {
         let take = Take::encode(std::slice::from_ref(&big)).unwrap();
         let back = &take.motions().unwrap()[0];
         let root = back.frames[0][0];
-        assert!((root.x - 1.3).abs() < 1e-3 && (root.z - 2.6).abs() < 1e-3, "{root}");
+        assert!(
+            (root.x - 1.3).abs() < 1e-3 && (root.z - 2.6).abs() < 1e-3,
+            "{root}"
+        );
         for pose in &back.frames {
             for j in 1..22 {
                 let bone = (pose[j] - pose[PARENTS[j]]).length();
@@ -188,7 +197,11 @@ mod tests {
         assert_eq!(f.len(), 30 * FEATURE_DIM);
         assert_eq!(&f[..5 * FEATURE_DIM], &a.features[0][..]);
         assert_eq!(&f[25 * FEATURE_DIM..], &b.features[0][..]);
-        assert!(f[5 * FEATURE_DIM..25 * FEATURE_DIM].iter().all(|v| *v == 0.5));
+        assert!(
+            f[5 * FEATURE_DIM..25 * FEATURE_DIM]
+                .iter()
+                .all(|v| *v == 0.5)
+        );
         assert!(Take::splice(&a, &b, 10, &mean).is_none(), "no gap");
         assert!(frames_of(&walk(5, 0.0, 0.0, 0.0), 2, 6).is_none());
         assert_eq!(frames_of(&walk(5, 0.0, 0.0, 0.0), 1, 3).unwrap().len(), 2);
