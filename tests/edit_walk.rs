@@ -22,7 +22,7 @@ use burn::prelude::*;
 use glam::Vec3;
 use mprog::formats::{LoadedMotion, Meta, read_motion, write_motion};
 use mprog::lang::{Program, compile};
-use mprog::metrics::per_motion::foot_skating_ratio;
+use mprog::metrics::per_motion::{foot_skating_ratio, max_bone_error};
 use mprog::model::ModelBundle;
 use mprog::model::sampler::SamplerKind;
 use mprog::model::weights::default_model_dir;
@@ -99,6 +99,7 @@ struct Row {
     program: f32,
     hand_head_max: f32,
     skating: f32,
+    bone: f32,
 }
 
 fn measure(label: &str, take: &Motion, edit: &Motion, program: &Program) -> Row {
@@ -136,17 +137,18 @@ fn measure(label: &str, take: &Motion, edit: &Motion, program: &Program) -> Row 
         program: program_error,
         hand_head_max,
         skating: foot_skating_ratio(edit),
+        bone: max_bone_error(edit),
     }
 }
 
 fn print(rows: &[Row]) {
     println!(
-        "| run | root path, max dev (m) | distance / take's | first half: max per-frame mean joint dev (m) | first half: max joint dev (m) | program error, 2nd half (m) | max hand–head, 2nd half (m) | foot skating |"
+        "| run | root path, max dev (m) | distance / take's | first half: max per-frame mean joint dev (m) | first half: max joint dev (m) | program error, 2nd half (m) | max hand–head, 2nd half (m) | foot skating | largest bone error (m) |"
     );
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for r in rows {
         println!(
-            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.4} | {:.3} | {:.3} |",
+            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.4} | {:.3} | {:.3} | {:.3} |",
             r.label,
             r.root_dev,
             r.distance_ratio,
@@ -154,7 +156,8 @@ fn print(rows: &[Row]) {
             r.first_half_max,
             r.program,
             r.hand_head_max,
-            r.skating
+            r.skating,
+            r.bone
         );
     }
 }

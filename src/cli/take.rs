@@ -42,8 +42,8 @@ pub struct TakeArgs {
     /// The inverse of `--keep`: only frames `a..b` change; the rest is held to the take.
     #[arg(long, requires = "from", value_name = "A..B", value_parser = parse_range)]
     pub edit: Option<RangeArg>,
-    /// Hold the take's path (root position, facing and height) on every frame and edit
-    /// only the body: the model otherwise walks its own way off the take's path. Leave it
+    /// Hold the take's path (root position and facing) on every frame and edit only the
+    /// body: the model otherwise walks its own way off the take's path. Leave it
     /// off when the program must move the path.
     #[arg(long, requires = "from", conflicts_with = "to")]
     pub keep_path: bool,

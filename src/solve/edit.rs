@@ -13,8 +13,8 @@
 //!   kept frames come back exactly (the skeleton projection of `guide`'s late steps
 //!   touches every frame).
 //!
-//! * **The path.** [`Edit::hold_path`] holds the take's root columns on every frame the
-//!   same way, so the body is edited on the take's own path.
+//! * **The path.** [`Edit::hold_path`] holds the take's turning speed and horizontal root
+//!   velocity on every frame the same way, so the body is edited on the take's own path.
 //!
 //! Kept frames keep their features: pose, velocities and contacts. The root is stored as
 //! velocities, so frames kept after an edited window follow on from where the edit leaves
@@ -49,16 +49,18 @@ pub struct Edit {
     /// Per frame, how firmly the frame is held to the take (1: kept, 0: free); empty when
     /// no frame is kept. Build it with [`hold_weights`].
     pub hold: Vec<f32>,
-    /// Hold the take's path on every frame: the root columns (turning speed, horizontal
-    /// velocity, height) stay the take's while the pose is edited, as MDM holds the root
-    /// in its body-part editing. The model walks off the take's path when it re-denoises
+    /// Hold the take's path on every frame: the root's turning speed and horizontal
+    /// velocity stay the take's while the body is edited, as MDM holds the root in its
+    /// body-part editing. The model walks off the take's path when it re-denoises
     /// it (a real walk drifted 0.9–2.5 m sideways in 7 s); a program that must move the
     /// path ("go around the pillar") leaves this off.
     pub hold_path: bool,
 }
 
-/// Root columns of a feature row: turning speed, horizontal velocity, height.
-const PATH_COLUMNS: usize = 4;
+/// Path columns of a feature row: turning speed and horizontal velocity. Not the root
+/// height: the other joints' heights are the edited body's, and the take's pelvis height
+/// on them stretched the hips by up to 8.5 cm.
+const PATH_COLUMNS: usize = 3;
 
 /// Per-frame hold weights of `frames` frames: 1 on every frame of `keep`, falling linearly
 /// over `blend` frames into the frames next to them (the seams), 0 elsewhere.
