@@ -9,9 +9,9 @@
 //!   take, `x̂0 ← w·take + (1 − w)·x̂0`, with a per-frame weight `w` that is 1 on kept frames
 //!   and falls linearly to 0 over [`Edit::blend`] frames into the edited window, so the
 //!   model continues the kept frames without a pop. A guided solver scales its steps by
-//!   `1 − w` (kept frames do not move), and the result is held once more at the end so
-//!   kept frames come back exactly (the skeleton projection of `guide`'s late steps
-//!   touches every frame).
+//!   `1 − w` (kept frames do not move), and frames of weight 1 are put back once more at
+//!   the end so they come back exactly (the skeleton projection of `guide`'s late steps
+//!   touches every frame); the seams stay as the chain left them.
 //!
 //! * **The path.** [`Edit::hold_path`] holds the take's turning speed and horizontal root
 //!   velocity on every frame the same way, so the body is edited on the take's own path.
@@ -143,6 +143,8 @@ pub struct EditState {
     take: Tensor<3>,
     /// `[B·P, N, 263]` hold weights (`None`: nothing kept).
     hold: Option<Tensor<3>>,
+    /// The same, 1 where the weight is 1 and 0 elsewhere (seams left as the chain made them).
+    exact: Option<Tensor<3>>,
     /// `[N, 263]` `1 − w`, the share of a step each frame's feature takes (empty: all 1).
     free: Vec<f32>,
 }
@@ -179,14 +181,20 @@ impl EditState {
             })
             .collect();
         let free = weights.iter().map(|w| 1.0 - w).collect();
-        let hold = held.then(|| {
-            Tensor::<3>::from_data(TensorData::new(weights, [1, n, FEATURE_DIM]), device)
-                .expand(dims)
-        });
+        let exact_weights: Vec<f32> = weights
+            .iter()
+            .map(|w| if *w >= 1.0 { 1.0 } else { 0.0 })
+            .collect();
+        let broadcast = |w: Vec<f32>| {
+            Tensor::<3>::from_data(TensorData::new(w, [1, n, FEATURE_DIM]), device).expand(dims)
+        };
+        let exact = held.then(|| broadcast(exact_weights));
+        let hold = held.then(|| broadcast(weights));
         EditState {
             strength: edit.strength,
             take,
             hold,
+            exact,
             free,
         }
     }
@@ -221,9 +229,14 @@ impl Ctx<'_> {
         }
     }
 
-    /// The final sample with kept frames put back exactly.
+    /// The final sample with kept frames (and a held path) put back exactly. Seams keep
+    /// what the chain made of them: re-blending there undid `guide`'s skeleton projection
+    /// of its last step, and a blend of two poses shortened bones by up to 16 cm.
     pub fn hold_final(&self, x: Tensor<3>) -> Tensor<3> {
-        self.hold_x0(x)
+        match self.edit.as_ref().and_then(|e| Some((e, e.exact.clone()?))) {
+            Some((edit, w)) => x.clone() + (edit.take.clone() - x) * w,
+            None => x,
+        }
     }
 
     /// Scales a step (or gradient) over `[B·P, N, width]` rows (the first `width` columns
