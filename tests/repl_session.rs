@@ -376,3 +376,39 @@ fn save_writes_the_program_and_the_motion_with_its_scores() {
     assert!(txt.contains(".bvh") && txt.contains(".mprog"), "{txt}");
     assert!(fails(&mut Session::new(None), ":save p.mprog").contains("empty"));
 }
+
+#[test]
+fn run_edits_the_take_loaded_with_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let take = dir.path().join("take.json");
+    mprog::formats::write_motion(&take, &[walk()], &mprog::formats::Meta::new()).unwrap();
+    let mut s = Session::new(Some(mprog::model::weights::default_model_dir()));
+    say(&mut s, "prompt \"a person walks forward\"");
+    say(&mut s, "length 2s");
+    say(&mut s, "head.y > 1 m");
+    assert!(fails(&mut s, ":run plain strength=0").contains(":motion"));
+    let loaded = say(&mut s, &format!(":motion {}", take.display()));
+    assert!(loaded.contains("edits this take"), "{loaded}");
+    // Strength 0 returns the take, retargeted: 40 frames give 39, where the take stood.
+    let out = say(&mut s, ":run plain strength=0");
+    assert!(
+        out.contains("editing") && out.contains("39 frames"),
+        "{out}"
+    );
+    let want = mprog::solve::Take::encode(&[walk()])
+        .unwrap()
+        .motions()
+        .unwrap();
+    let got = &s.motion().unwrap().people[0];
+    for (a, b) in got.frames.iter().zip(&want[0].frames) {
+        assert!(a.iter().zip(b).all(|(p, q)| (*p - *q).length() < 1e-4));
+    }
+    assert!(fails(&mut s, ":run plain strength=1.5").contains("outside 0…1"));
+    assert!(fails(&mut s, ":run latent strength=0.5").contains("cannot edit a take"));
+    // A short edited chain runs, and `:gen` would end the editing.
+    let out = say(
+        &mut s,
+        ":run guide 2 steps=10 k_late=20 late_steps=2 strength=0.5",
+    );
+    assert!(out.contains("at strength 0.5"), "{out}");
+}

@@ -15,6 +15,7 @@ pub mod mcp;
 pub mod repl;
 pub mod run;
 pub mod score;
+pub mod take;
 pub mod train;
 pub mod train_control;
 pub mod view;

@@ -70,6 +70,8 @@ pub struct RunArgs {
     out: Vec<PathBuf>,
     #[command(flatten)]
     export: super::export::ExportArgs,
+    #[command(flatten)]
+    take: super::take::TakeArgs,
 }
 
 fn prompts_of(program: &Program, text: &Option<String>) -> Result<Vec<String>> {
@@ -180,9 +182,18 @@ pub fn run(args: RunArgs) -> Result<()> {
             }
         }
     }
-    let frames = program.length();
-    let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.clone())
-        .placed(program.placements());
+    let plan = super::take::plan(&args.take, &program, bundle.config.max_frames)?;
+    let edit = plan.as_ref().map(|p| p.edit(&bundle.mean)).transpose()?;
+    let frames = edit.as_ref().map_or(program.length(), |e| e.take.frames);
+    let request = |solver: Solver| {
+        let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver)
+            .placed(program.placements());
+        match &edit {
+            Some(e) => req.editing(e.clone()),
+            None => req,
+        }
+    };
+    let req = request(solver.clone());
     let result = solve_with_bar(
         &bundle,
         control.as_ref(),
@@ -196,8 +207,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let baseline = if args.no_baseline {
         None
     } else {
-        let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver.unguided())
-            .placed(program.placements());
+        let req = request(solver.unguided());
         let r = solve_with_bar(
             &bundle,
             control.as_ref(),
@@ -269,6 +279,9 @@ pub fn run(args: RunArgs) -> Result<()> {
         bundle.manifest.weights_id.clone().into(),
     );
     meta.insert("prompts".into(), serde_json::json!(prompts));
+    if let Some(plan) = &plan {
+        meta.insert("edit".into(), plan.meta.clone().into());
+    }
     meta.extend(mprog::view::program::program_meta(&program, people, &device).into_diagnostic()?);
     let written = write_outputs_with(
         &args.out,

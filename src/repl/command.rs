@@ -9,7 +9,8 @@ use std::path::PathBuf;
 pub enum Command {
     /// `:load prog.mprog`: replace the session's program with a file.
     Load(PathBuf),
-    /// `:motion file`: make a motion file (bvh, npy, json) the current motion.
+    /// `:motion file`: make a motion file (bvh, npy, json) the current motion, and the take
+    /// `:run` edits.
     Motion(PathBuf),
     /// `:gen "prompt" [seconds] [seed]`: generate the current motion with the model.
     Gen {
@@ -95,7 +96,7 @@ pub const COMMANDS: &[CommandDoc] = &[
         "motion",
         &["m"],
         "FILE",
-        "load the current motion (.bvh, .npy, .json)",
+        "load the current motion (.bvh, .npy, .json); `:run` then edits it",
     ),
     doc(
         "gen",
@@ -106,8 +107,8 @@ pub const COMMANDS: &[CommandDoc] = &[
     doc(
         "run",
         &[],
-        "[SOLVER] [SEED] [KNOB=VALUE …]",
-        "solve the session's program with the model (`:help run` lists the solvers and their knobs; default guide, seed 1); the result becomes the current motion",
+        "[SOLVER] [SEED] [KNOB=VALUE …] [strength=S]",
+        "solve the session's program with the model (`:help run` lists the solvers and their knobs; default guide, seed 1); after `:motion FILE` it edits that take (`strength=S`, 0 keeps it, 1 ignores it); the result becomes the current motion",
     ),
     doc(
         "eval",

@@ -20,7 +20,7 @@ use crate::model::sampler::SamplerKind;
 use crate::motion::Motion;
 use crate::skeleton::FPS;
 use crate::solve::cleanup::{FootCleanup, clean_generated};
-use crate::solve::{Prior, SolveRequest, Solver, solve};
+use crate::solve::{DEFAULT_STRENGTH, Edit, Prior, SolveRequest, Solver, Take, solve};
 use burn::tensor::Device;
 use std::path::{Path, PathBuf};
 
@@ -54,6 +54,8 @@ impl CurrentMotion {
 pub struct Session {
     program: String,
     motion: Option<CurrentMotion>,
+    /// The motion loaded with `:motion`, which `:run` edits (cleared by `:gen`).
+    take: Option<CurrentMotion>,
     model_dir: Option<PathBuf>,
     bundle: Option<ModelBundle>,
     device: Device,
@@ -65,6 +67,7 @@ impl Session {
         Session {
             program: String::new(),
             motion: None,
+            take: None,
             model_dir,
             bundle: None,
             device: Device::flex(),
@@ -246,7 +249,11 @@ impl Session {
             },
         };
         self.set_motion(people, name);
-        Reply::text(self.describe_motion())
+        self.take = self.motion.clone();
+        Reply::text(format!(
+            "{}\n`:run` now edits this take (`strength=S`, 0…1, default {DEFAULT_STRENGTH}); `:gen` ends that",
+            self.describe_motion()
+        ))
     }
 
     fn gen_motion(&mut self, prompt: &str, seconds: f32, seed: u64) -> Reply {
@@ -271,6 +278,7 @@ impl Session {
         match out {
             Err(e) => Reply::error(format!("generation failed: {e}")),
             Ok(g) => {
+                self.take = None;
                 let unknown = g.unknown_words.first().cloned().unwrap_or_default();
                 self.set_motion(
                     g.motions,
@@ -306,16 +314,42 @@ impl Session {
                 Solver::names().join(", ")
             ));
         };
+        let mut strength = None;
         for (k, v) in knobs {
-            if let Err(e) = solver.set_knob(k, *v) {
+            if k == "strength" {
+                strength = Some(*v as f32);
+            } else if let Err(e) = solver.set_knob(k, *v) {
                 return Reply::error(e);
             }
         }
         let Some(prompts) = program.prompts().into_iter().collect::<Option<Vec<_>>>() else {
             return Reply::error("every person needs a prompt: add `prompt \"…\"` to the program");
         };
-        let req = SolveRequest::new(prompts, program.length(), seed, solver.clone())
-            .placed(program.placements());
+        let edit = match (&self.take, strength) {
+            (None, Some(_)) => {
+                return Reply::error("`strength` edits a take: load one with `:motion FILE` first");
+            }
+            (None, None) => None,
+            (Some(take), s) => match take_edit(take, s.unwrap_or(DEFAULT_STRENGTH)) {
+                Ok(e) => Some(e),
+                Err(e) => return Reply::error(e),
+            },
+        };
+        let frames = edit.as_ref().map_or(program.length(), |e| e.take.frames);
+        let mut req =
+            SolveRequest::new(prompts, frames, seed, solver.clone()).placed(program.placements());
+        let origin = match (edit, &self.take) {
+            (Some(e), Some(take)) => {
+                let s = e.strength;
+                req = req.editing(e);
+                format!(
+                    ":run {} seed {seed} editing {} at strength {s}",
+                    solver.name(),
+                    take.origin
+                )
+            }
+            _ => format!(":run {} seed {seed}", solver.name()),
+        };
         let device = self.device.clone();
         let error: &dyn crate::solve::MotionError = &program;
         let result = match self.bundle() {
@@ -327,7 +361,7 @@ impl Session {
             Ok(r) => {
                 let seconds = r.seconds;
                 let people = r.motions.into_iter().next().unwrap_or_default();
-                self.set_motion(people, format!(":run {} seed {seed}", solver.name()));
+                self.set_motion(people, origin);
                 let mut reply = Reply::text(format!(
                     "{} in {seconds:.1} s; {}",
                     solver.name(),
@@ -464,6 +498,24 @@ impl Session {
             .collect::<Vec<_>>()
             .join("\n")
     }
+}
+
+/// The edit of `take` at `strength`: every frame may change, none is kept (windows are
+/// `mprog run --keep`'s).
+fn take_edit(take: &CurrentMotion, strength: f32) -> Result<Edit, String> {
+    if !(strength.is_finite() && (0.0..=1.0).contains(&strength)) {
+        return Err(format!(
+            "strength {strength} is outside 0…1 (0 returns the take, 1 ignores it)"
+        ));
+    }
+    let take = Take::encode(&take.people)
+        .map_err(|e| format!("cannot encode the take {}: {e}", take.origin))?;
+    Ok(Edit {
+        take,
+        strength,
+        hold: Vec::new(),
+        hold_path: false,
+    })
 }
 
 /// Message when a command needs a motion.

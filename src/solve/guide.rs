@@ -234,13 +234,13 @@ fn run(
     let cond = ctx.condition(&ctx.device);
     let mut noise = ctx.step_noise();
     let dims = ctx.dims();
-    let n = schedule.len();
     let mut objective = ctx.host_objective();
-    let mut x = ctx.initial_tensor(&ctx.device);
+    // A take starts the chain part-way down and holds its kept frames (`super::edit`).
+    let (n, mut x) = ctx.chain_start(&schedule);
     let mut trace = Vec::with_capacity(n);
     let mut realism = Realism::new(ctx, ctx.prior.control.filter(|_| cfg.realism));
     for i in (0..n).rev() {
-        let x0 = realism.x0(&den, x.clone(), schedule.timesteps[i], &cond);
+        let x0 = ctx.hold_x0(realism.x0(&den, x.clone(), schedule.timesteps[i], &cond));
         let mut mu = posterior_mean(&schedule, i, x, x0);
         let k = cfg.iterations_at(i);
         let post = schedule.posterior(i);
@@ -282,7 +282,7 @@ fn run(
         });
     }
     Ok(Outcome {
-        x: host(x),
+        x: host(ctx.hold_final(x)),
         relax: None,
         trace,
     })
@@ -400,6 +400,9 @@ fn step_direction(
             dir[f0..f0 + width].fill(0.0);
         }
     }
+    // Frames kept from a take do not move; seams move partly.
+    ctx.hold_step(g, width);
+    ctx.hold_step(&mut dir, width);
     dir
 }
 
@@ -643,5 +646,9 @@ impl SolverConfig for GuideConfig {
 
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
         run(ctx, self, progress)
+    }
+
+    fn edit_refusal(&self) -> Option<&'static str> {
+        None
     }
 }

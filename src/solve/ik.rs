@@ -177,4 +177,7 @@ impl SolverConfig for IkConfig {
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
         run(ctx, self, progress)
     }
+    fn edit_refusal(&self) -> Option<&'static str> {
+        Some("it optimises the unguided sample's features, not a take's")
+    }
 }

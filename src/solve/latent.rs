@@ -389,4 +389,7 @@ impl SolverConfig for LatentConfig {
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
         run(ctx, self, progress)
     }
+    fn edit_refusal(&self) -> Option<&'static str> {
+        Some("it optimises the noise of a DDIM chain, and inverting a take to its noise (DDIM inversion) is not implemented")
+    }
 }

@@ -379,4 +379,7 @@ impl SolverConfig for LbfgsConfig {
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
         run(ctx, self, progress)
     }
+    fn edit_refusal(&self) -> Option<&'static str> {
+        Some("holding kept frames inside its L-BFGS steps is not implemented")
+    }
 }

@@ -19,6 +19,11 @@
 //! defaults; [`registry`] lists them. A new solver is its file and one line in
 //! `registry!` below (`toy`, a test-only solver, shows the minimum).
 //!
+//! Editing a take ([`take`], [`edit`]): a request may carry an [`Edit`], a motion the user
+//! has, encoded to features with its world placement; `guide` and `plain` start their chain
+//! part-way down from it (its strength) and hold its kept frames at every step, the other
+//! solvers refuse it with their reason ([`SolverConfig::edit_refusal`]).
+//!
 //! Many people: P prompts are sampled as one batch of B·P motions (sample-major: index
 //! `b·P + p`, CFG doubles it to 2·B·P), each person's joints are moved into the world by
 //! its [`Placement`] (two people: InterControl's facing placement 2 m apart; more: a circle)
@@ -48,6 +53,7 @@ pub mod adam;
 pub mod bones;
 pub mod cleanup;
 mod decode;
+pub mod edit;
 pub mod feet;
 pub mod host;
 pub mod knobs;
@@ -56,6 +62,7 @@ pub mod reference;
 mod request;
 mod run;
 mod solver;
+pub mod take;
 
 /// Declares the solver modules and [`registry`], which lists their [`SolverSpec`]s (each
 /// module's `SPECS`) in help order.
@@ -85,10 +92,13 @@ registry! {
 }
 
 #[cfg(test)]
+mod edit_tests;
+#[cfg(test)]
 mod tests;
 
 pub use crate::scene::{DEFAULT_SPACING, Placement};
 pub use decode::{Decoder, RigidTensors};
+pub use edit::{DEFAULT_BLEND, DEFAULT_STRENGTH, Edit, hold_weights, in_between_hold};
 pub use guide::{GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;
 pub use knobs::{KnobKind, KnobValue};
@@ -98,6 +108,7 @@ pub use plain::PlainConfig;
 pub use request::{Phase, Prior, Progress, SolveRequest, SolveResult};
 pub use run::{Ctx, Outcome, solve};
 pub use solver::{Solver, SolverConfig, SolverSpec, solvers_help};
+pub use take::Take;
 
 pub use crate::objective::MotionError;
 

@@ -51,9 +51,13 @@ impl SolverConfig for PlainConfig {
 
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
         Ok(Outcome {
-            x: host(ctx.sample_plain(self.sampler, progress)),
+            x: host(ctx.sample_edited(self.sampler, progress)),
             relax: None,
             trace: Vec::new(),
         })
+    }
+
+    fn edit_refusal(&self) -> Option<&'static str> {
+        None
     }
 }

@@ -151,6 +151,7 @@ mod tests {
             guidance_scale: 1.0,
             prompts: vec!["a person walks forward".into()],
             decoder: Decoder::new(&bundle.mean, &bundle.std, &[Placement::IDENTITY]),
+            edit: None,
         };
         let before = ctx.initial_noise();
         let after: Vec<f32> = before.iter().map(|v| v * 0.5 + 0.1).collect();

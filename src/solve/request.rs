@@ -1,6 +1,7 @@
 //! The common solver API: what to solve ([`SolveRequest`]), with which model
 //! ([`Prior`]), what comes back ([`SolveResult`]) and progress reports ([`Progress`]).
 
+use super::edit::Edit;
 use super::solver::Solver;
 use crate::model::control::ControlNet;
 use crate::model::prompt::PromptEncoder;
@@ -61,6 +62,9 @@ pub struct SolveRequest {
     pub placements: Option<Vec<Placement>>,
     /// The solver and its settings.
     pub solver: Solver,
+    /// A take to edit instead of starting from noise ([`super::edit`]); its people stand
+    /// where the take stands, whatever `placements` says.
+    pub edit: Option<Edit>,
 }
 
 impl SolveRequest {
@@ -74,6 +78,7 @@ impl SolveRequest {
             guidance_scale: 2.5,
             placements: None,
             solver,
+            edit: None,
         }
     }
 
@@ -81,6 +86,14 @@ impl SolveRequest {
     pub fn placed(self, placements: Vec<Placement>) -> Self {
         SolveRequest {
             placements: Some(placements),
+            ..self
+        }
+    }
+
+    /// The same request editing this take.
+    pub fn editing(self, edit: Edit) -> Self {
+        SolveRequest {
+            edit: Some(edit),
             ..self
         }
     }

@@ -3,6 +3,7 @@
 //! motions, features and final errors.
 
 use super::decode::Decoder;
+use super::edit::EditState;
 use super::host::{HostObjective, check_shape};
 use super::request::{Phase, Prior, Progress, SolveRequest, SolveResult};
 use super::{MotionError, SolveError};
@@ -38,6 +39,8 @@ pub struct Ctx<'a> {
     /// One prompt per motion, sample-major (`b·P + p`).
     pub prompts: Vec<String>,
     pub decoder: Decoder,
+    /// The take being edited, if any ([`super::edit`]).
+    pub edit: Option<EditState>,
 }
 
 /// What a solver hands back: normalised samples and, when it relaxes, a transform per motion.
@@ -170,7 +173,23 @@ fn validate(prior: &Prior, req: &SolveRequest) -> Result<Vec<Placement>, SolveEr
     if !(req.guidance_scale.is_finite()) {
         return bad("the classifier-free guidance scale must be a finite number".into());
     }
+    if let Some(edit) = &req.edit {
+        if let Some(why) = req.solver.edit_refusal() {
+            let takers: Vec<&str> = super::registry()
+                .iter()
+                .filter(|s| (s.make)().edit_refusal().is_none())
+                .map(|s| s.name)
+                .collect();
+            return bad(format!(
+                "solver `{}` cannot edit a take: {why}; use {}",
+                req.solver.name(),
+                takers.join(" or ")
+            ));
+        }
+        edit.check(req.prompts.len(), req.frames)?;
+    }
     let placements = match &req.placements {
+        _ if req.edit.is_some() => req.edit.as_ref().expect("edit").take.placements.clone(),
         Some(p) if p.len() != req.prompts.len() => {
             return bad(format!(
                 "{} placements for {} people; give one per person",
@@ -227,6 +246,10 @@ pub fn solve(
             .flat_map(|_| req.prompts.iter().cloned())
             .collect(),
         decoder: Decoder::new(prior.mean, prior.std, &placements),
+        edit: req
+            .edit
+            .as_ref()
+            .map(|e| EditState::new(e, req.samples, prior.mean, prior.std, device)),
     };
     let progress: &mut dyn FnMut(Progress) = &mut on_progress;
     let out = req.solver.run(&ctx, progress)?;

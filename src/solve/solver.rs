@@ -29,6 +29,12 @@ pub trait SolverConfig: Any + Clone + fmt::Debug + PartialEq + Send + Sync {
 
     /// Solves the request in `ctx`; returns normalised samples.
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError>;
+
+    /// Why it cannot edit a take (`--from`, [`super::edit`]), or `None` when it can (its
+    /// run then starts from [`Ctx::chain_start`] and holds kept frames).
+    fn edit_refusal(&self) -> Option<&'static str> {
+        Some("it only starts from noise")
+    }
 }
 
 /// A registered solver: its name, a line on what it moves, and its default settings.
@@ -126,6 +132,11 @@ impl Solver {
         self.0.validate()
     }
 
+    /// Why it cannot edit a take, or `None` when it can.
+    pub fn edit_refusal(&self) -> Option<&'static str> {
+        self.0.edit_refusal()
+    }
+
     pub(crate) fn run(
         &self,
         ctx: &Ctx,
@@ -161,6 +172,7 @@ trait DynSolver: Send + Sync {
     fn knobs(&self) -> Vec<KnobValue>;
     fn set_knob(&mut self, name: &str, value: f64) -> Result<(), String>;
     fn validate(&self) -> Result<(), SolveError>;
+    fn edit_refusal(&self) -> Option<&'static str>;
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError>;
     fn clone_box(&self) -> Box<dyn DynSolver>;
     fn eq_dyn(&self, other: &dyn Any) -> bool;
@@ -205,6 +217,10 @@ impl<C: SolverConfig> DynSolver for C {
 
     fn validate(&self) -> Result<(), SolveError> {
         SolverConfig::validate(self)
+    }
+
+    fn edit_refusal(&self) -> Option<&'static str> {
+        SolverConfig::edit_refusal(self)
     }
 
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {

@@ -1,0 +1,378 @@
+//! Editing real takes with the shipped model (issue 30's "done when"), slow, so `--ignored`:
+//!
+//! ```sh
+//! cargo test --release --test edit_walk -- --ignored --nocapture
+//! ```
+//!
+//! * **A real walk** of the test split (Bandai `dataset-1_walk_happy_001`) edited with "the
+//!   left hand within 15 cm of the head for the second half", at several strengths and
+//!   with the first half kept: how far the root path moves from the take, the travelled
+//!   distance, how far the first half moves, and the program's error on the second half.
+//! * **An in-between** of two real clips (the end of that walk, the start of
+//!   `dataset-1_run_happy_001`): the largest frame-to-frame joint jump against the
+//!   clips' own, and foot skating against theirs.
+//!
+//! The takes come from `data/raw` (or `$MPROG_BVH_DIR`); without them the tests say so and
+//! pass. Pictures of each run land in `target/edit_walk/`.
+
+// A list of one frame range is what `hold_weights` takes, not a range to collect.
+#![allow(clippy::single_range_in_vec_init)]
+
+use burn::prelude::*;
+use glam::Vec3;
+use mprog::formats::{LoadedMotion, Meta, read_motion, write_motion};
+use mprog::lang::{Program, compile};
+use mprog::metrics::per_motion::{foot_skating_ratio, max_bone_error};
+use mprog::model::ModelBundle;
+use mprog::model::sampler::SamplerKind;
+use mprog::model::weights::default_model_dir;
+use mprog::motion::Motion;
+use mprog::solve::take::frames_of;
+use mprog::solve::{
+    DEFAULT_BLEND, DEFAULT_STRENGTH, Edit, GuideConfig, Prior, SolveRequest, Solver, Take,
+    hold_weights, in_between_hold, solve,
+};
+use std::path::PathBuf;
+
+const WALK: &str = "dataset-1_walk_happy_001";
+const RUN: &str = "dataset-1_run_happy_001";
+
+/// A Bandai take of the test split, or `None` (with a message) when the archive is absent.
+fn bandai(name: &str) -> Option<Motion> {
+    let root = std::env::var_os("MPROG_BVH_DIR").map_or_else(
+        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/raw"),
+        PathBuf::from,
+    );
+    let path = root.join(format!(
+        "dataset/Bandai-Namco-Research-Motiondataset-1/data/{name}.bvh"
+    ));
+    if !path.exists() {
+        eprintln!(
+            "skipping: {} is missing (unpack the Bandai archive into data/raw)",
+            path.display()
+        );
+        return None;
+    }
+    match read_motion(&path).unwrap() {
+        LoadedMotion::Joints { mut people, .. } => Some(people.remove(0).motion),
+        LoadedMotion::Features(_) => panic!("a BVH gives joints"),
+    }
+}
+
+fn out_dir() -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/edit_walk");
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn save(name: &str, people: &[Motion]) {
+    for ext in ["json", "png"] {
+        write_motion(
+            &out_dir().join(format!("{name}.{ext}")),
+            people,
+            &Meta::new(),
+        )
+        .unwrap();
+    }
+}
+
+/// Horizontal distance between two points.
+fn flat(a: Vec3, b: Vec3) -> f32 {
+    Vec3::new(a.x - b.x, 0.0, a.z - b.z).length()
+}
+
+/// Root path length over the horizontal plane.
+fn travelled(m: &Motion) -> f32 {
+    m.frames.windows(2).map(|w| flat(w[1][0], w[0][0])).sum()
+}
+
+/// One measured edit: label, solver, strength, kept frames, path held.
+type Run = (String, Solver, f32, Vec<std::ops::Range<usize>>, bool);
+
+/// How one edit compares with its take.
+struct Row {
+    label: String,
+    root_dev: f32,
+    distance_ratio: f32,
+    first_half_mean: f32,
+    first_half_max: f32,
+    program: f32,
+    hand_head_max: f32,
+    skating: f32,
+    bone: f32,
+}
+
+fn measure(label: &str, take: &Motion, edit: &Motion, program: &Program) -> Row {
+    let n = edit.len();
+    let half = n / 2;
+    let root_dev = (0..n)
+        .map(|t| flat(edit.frames[t][0], take.frames[t][0]))
+        .fold(0.0, f32::max);
+    let per_frame = |t: usize| -> (f32, f32) {
+        let d: Vec<f32> = (0..22)
+            .map(|j| (edit.frames[t][j] - take.frames[t][j]).length())
+            .collect();
+        (
+            d.iter().sum::<f32>() / 22.0,
+            d.iter().copied().fold(0.0, f32::max),
+        )
+    };
+    let (first_half_mean, first_half_max) = (0..half)
+        .map(per_frame)
+        .fold((0.0f32, 0.0f32), |(a, b), (m, x)| (a.max(m), b.max(x)));
+    let joints = Tensor::<5>::from_data(
+        TensorData::new(edit.to_flat(), [1, 1, n, 22, 3]),
+        &Device::flex(),
+    );
+    let program_error = program.evaluate(joints).total.into_scalar::<f32>();
+    let hand_head_max = (half..n)
+        .map(|t| (edit.frames[t][20] - edit.frames[t][15]).length())
+        .fold(0.0, f32::max);
+    Row {
+        label: label.into(),
+        root_dev,
+        distance_ratio: travelled(edit) / travelled(take),
+        first_half_mean,
+        first_half_max,
+        program: program_error,
+        hand_head_max,
+        skating: foot_skating_ratio(edit),
+        bone: max_bone_error(edit),
+    }
+}
+
+fn print(rows: &[Row]) {
+    println!(
+        "| run | root path, max dev (m) | distance / take's | first half: max per-frame mean joint dev (m) | first half: max joint dev (m) | program error, 2nd half (m) | max hand–head, 2nd half (m) | foot skating | largest bone error (m) |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    for r in rows {
+        println!(
+            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.4} | {:.3} | {:.3} | {:.3} |",
+            r.label,
+            r.root_dev,
+            r.distance_ratio,
+            r.first_half_mean,
+            r.first_half_max,
+            r.program,
+            r.hand_head_max,
+            r.skating,
+            r.bone
+        );
+    }
+}
+
+fn edit_once(
+    bundle: &ModelBundle,
+    program: &Program,
+    prompt: &str,
+    solver: Solver,
+    edit: Edit,
+) -> Motion {
+    let req = SolveRequest::new(vec![prompt.into()], edit.take.frames, 1, solver).editing(edit);
+    let out = solve(
+        &Prior::from_bundle(bundle),
+        &req,
+        program,
+        &Device::flex(),
+        |_| {},
+    )
+    .expect("the edit runs");
+    out.motions[0][0].clone()
+}
+
+#[test]
+#[ignore = "minutes with the shipped model: cargo test --release --test edit_walk -- --ignored --nocapture"]
+fn editing_a_real_walk() {
+    let Some(walk) = bandai(WALK) else { return };
+    let bundle = ModelBundle::load(&default_model_dir(), &Device::flex()).unwrap();
+    let take = Take::encode(std::slice::from_ref(&walk)).unwrap();
+    let n = take.frames;
+    let source = format!(
+        "prompt \"a happy person walks forward\"\nlength {n} frames\nduring 50%..100% {{ dist(l_hand, head) < 15 cm }}\n"
+    );
+    let program = compile(&source, "hand_on_head_second_half.mprog", &[]).unwrap();
+    let prompt = "a happy person walks forward";
+    let retargeted = take.motions().unwrap().remove(0);
+    save("take", std::slice::from_ref(&retargeted));
+    let mut rows = vec![measure(
+        "take (strength 0)",
+        &retargeted,
+        &retargeted,
+        &program,
+    )];
+    let mut at_default = None;
+    let guide = || Solver::new(GuideConfig::default());
+    let runs: Vec<Run> = vec![
+        ("guide".into(), guide(), 0.3, vec![], false),
+        ("guide".into(), guide(), 0.5, vec![], false),
+        ("guide, --keep-path".into(), guide(), 0.3, vec![], true),
+        ("guide, --keep-path".into(), guide(), 0.5, vec![], true),
+        ("guide, --keep-path".into(), guide(), 0.7, vec![], true),
+        ("guide, --keep-path".into(), guide(), 1.0, vec![], true),
+        (
+            format!("guide, --keep-path --keep ..{}", n / 2 - 10),
+            guide(),
+            0.5,
+            vec![0..n / 2 - 10],
+            true,
+        ),
+        (
+            format!("guide, --keep ..{}", n / 2),
+            guide(),
+            0.5,
+            vec![0..n / 2],
+            false,
+        ),
+        (
+            "plain (unguided), --keep-path".into(),
+            Solver::plain(SamplerKind::Ddpm(1000)),
+            0.5,
+            vec![],
+            true,
+        ),
+    ];
+    for (i, (label, solver, s, keep, path)) in runs.into_iter().enumerate() {
+        let e = Edit {
+            take: take.clone(),
+            strength: s,
+            hold: if keep.is_empty() {
+                Vec::new()
+            } else {
+                hold_weights(n, &keep, DEFAULT_BLEND)
+            },
+            hold_path: path,
+        };
+        let default =
+            s == DEFAULT_STRENGTH && path && keep.is_empty() && label.starts_with("guide");
+        let m = edit_once(&bundle, &program, prompt, solver, e);
+        save(&format!("edit_{i}"), std::slice::from_ref(&m));
+        let row = measure(
+            &format!("{label}, strength {s} (edit_{i})"),
+            &retargeted,
+            &m,
+            &program,
+        );
+        if default {
+            at_default = Some(measure("default", &retargeted, &m, &program));
+        }
+        rows.push(row);
+    }
+    print(&rows);
+    let r = at_default.expect("the default strength is measured");
+    assert!(
+        r.root_dev <= 0.2,
+        "root path {:.3} m from the take",
+        r.root_dev
+    );
+    assert!(
+        (r.distance_ratio - 1.0).abs() <= 0.1,
+        "distance ratio {:.3}",
+        r.distance_ratio
+    );
+    assert!(
+        r.first_half_mean <= 0.15,
+        "first half {:.3} m from the take",
+        r.first_half_mean
+    );
+    assert!(
+        r.program <= 0.01,
+        "second half: program error {:.4} m",
+        r.program
+    );
+}
+
+/// Largest frame-to-frame move of any joint.
+fn largest_jump(m: &Motion) -> f32 {
+    m.frames
+        .windows(2)
+        .flat_map(|w| (0..22).map(move |j| (w[1][j] - w[0][j]).length()))
+        .fold(0.0, f32::max)
+}
+
+#[test]
+#[ignore = "a minute with the shipped model: cargo test --release --test edit_walk -- --ignored --nocapture"]
+fn in_between_two_real_clips() {
+    let (Some(walk), Some(run)) = (bandai(WALK), bandai(RUN)) else {
+        return;
+    };
+    let bundle = ModelBundle::load(&default_model_dir(), &Device::flex()).unwrap();
+    let (context, frames) = (20, 100);
+    let a = frames_of(&walk, walk.len() - context - 1, walk.len()).unwrap();
+    let b = frames_of(&run, 0, context + 1).unwrap();
+    let take = Take::splice(
+        &Take::encode(&[a]).unwrap(),
+        &Take::encode(&[b]).unwrap(),
+        frames,
+        &bundle.mean,
+    )
+    .unwrap();
+    // The clips as the model's skeleton draws them.
+    let clip = |m: &Motion| {
+        Take::encode(std::slice::from_ref(m))
+            .unwrap()
+            .motions()
+            .unwrap()
+            .remove(0)
+    };
+    let (walk_r, run_r) = (clip(&walk), clip(&run));
+    let own = largest_jump(&walk_r).max(largest_jump(&run_r));
+    let real_skating = (foot_skating_ratio(&walk_r) + foot_skating_ratio(&run_r)) / 2.0;
+    println!("| blend (frames) | seam 1 jump (m/frame) | seam 2 jump | whole | foot skating |");
+    println!("| --- | --- | --- | --- | --- |");
+    println!("| clips' own (walk, run) | | | {own:.3} | {real_skating:.3} |");
+    let mut at_default = None;
+    for blend in [DEFAULT_BLEND, 2 * DEFAULT_BLEND] {
+        let edit = Edit {
+            take: take.clone(),
+            strength: 1.0,
+            hold: in_between_hold(frames, context, blend),
+            hold_path: false,
+        };
+        let none = |j: Tensor<5>| j.sum_dim(4).sum_dim(3).sum_dim(2).sum_dim(1).reshape([1]) * 0.0;
+        let req = SolveRequest::new(
+            vec!["a happy person walks forward then runs forward".into()],
+            frames,
+            1,
+            Solver::plain(SamplerKind::Ddpm(1000)),
+        )
+        .editing(edit);
+        let out = solve(
+            &Prior::from_bundle(&bundle),
+            &req,
+            &none,
+            &Device::flex(),
+            |_| {},
+        )
+        .unwrap();
+        let m = out.motions[0][0].clone();
+        save(
+            &format!("in_between_blend{blend}"),
+            std::slice::from_ref(&m),
+        );
+        // The largest jump within 5 frames of each end of the gap.
+        let seam = |t: usize| {
+            (t.saturating_sub(5)..(t + 5).min(frames - 1))
+                .flat_map(|u| (0..22).map(move |j| (u, j)))
+                .map(|(u, j)| (m.frames[u + 1][j] - m.frames[u][j]).length())
+                .fold(0.0, f32::max)
+        };
+        println!(
+            "| {blend} | {:.3} | {:.3} | {:.3} | {:.3} |",
+            seam(context),
+            seam(frames - context),
+            largest_jump(&m),
+            foot_skating_ratio(&m)
+        );
+        if blend == DEFAULT_BLEND {
+            at_default = Some(m);
+        }
+    }
+    let m = &at_default.unwrap();
+    assert!(
+        largest_jump(m) <= own,
+        "jump {:.3} vs the clips' {own:.3}",
+        largest_jump(m)
+    );
+    assert!(foot_skating_ratio(m) <= 1.5 * real_skating.max(1e-3));
+}
