@@ -14,6 +14,7 @@ fn config(out: &std::path::Path) -> Config {
         model: None,
         time_limit: Duration::from_secs(5),
         card: None,
+        far_prompts: None,
     }
 }
 

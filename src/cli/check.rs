@@ -2,8 +2,7 @@
 //! report, or JSON for repair loops), exit with status 1 when any has errors.
 
 use clap::{Args, ValueEnum};
-use mprog::lang::{Diagnostic, Diagnostics};
-use mprog::model::prompt::{PromptEncoder, far_prompt_line};
+use mprog::model::prompt::PromptEncoder;
 use mprog::model::sentence::FAR_COSINE;
 use std::path::PathBuf;
 
@@ -46,53 +45,34 @@ pub fn parse_override(s: &str) -> Result<(String, f64), String> {
 
 /// The shipped model's prompt encoder when it reads sentences (only then is "far from
 /// the training captions" measurable); None without a loadable sentence model.
-fn sentence_reader() -> Option<PromptEncoder> {
-    let dir = mprog::model::weights::default_model_dir();
+pub fn sentence_reader(dir: &std::path::Path) -> Option<PromptEncoder> {
     let config = std::fs::read_to_string(dir.join("config.toml")).ok()?;
     if !config.contains("text_encoder") {
         return None;
     }
     let device = super::device().ok()?;
-    let bundle = mprog::model::ModelBundle::load(&dir, &device).ok()?;
+    let bundle = mprog::model::ModelBundle::load(dir, &device).ok()?;
     matches!(bundle.text, PromptEncoder::Sentences(_)).then_some(bundle.text)
 }
 
-/// `mprog::far_prompt` warnings for prompts far from every training caption.
-fn with_prompt_warnings(diags: Diagnostics, source: &str, text: &PromptEncoder) -> Diagnostics {
-    let mut items = diags.items;
-    for (prompt, span) in mprog::lang::prompts_of(source) {
-        if let Some(n) = text.nearest_caption(&prompt)
-            && n.cosine < FAR_COSINE
-        {
-            items.push(
-                Diagnostic::warning(
-                    mprog::lang::codes::FAR_PROMPT,
-                    span,
-                    format!("the motion model was never trained on anything like \"{prompt}\""),
-                )
-                .label("far from every training caption")
-                .help(format!(
-                    "{}; the motion will follow the constraints more than the words. `mprog prompt` lists the actions the model knows",
-                    far_prompt_line(&n)
-                )),
-            );
-        }
-    }
-    Diagnostics::new(&diags.name, diags.source, items)
+/// The nearest-caption lookup of a sentence model, for [`mprog::lang::with_far_prompts`].
+pub fn nearest_caption_of(text: PromptEncoder) -> Box<mprog::lang::NearestCaption> {
+    Box::new(move |prompt: &str| text.nearest_caption(prompt).map(|n| (n.caption, n.cosine)))
 }
 
 /// Runs `mprog check`; returns whether every file is free of errors.
 pub fn run(args: &CheckArgs) -> miette::Result<bool> {
     let mut all_ok = true;
     let mut json = Vec::new();
-    let reader = sentence_reader();
+    let reader =
+        sentence_reader(&mprog::model::weights::default_model_dir()).map(nearest_caption_of);
     for path in &args.files {
         let name = path.display().to_string();
         let source = std::fs::read_to_string(path)
             .map_err(|e| miette::miette!("cannot read {name}: {e}"))?;
         let diags = mprog::lang::check_source(&source, &name, &args.set);
         let diags = match &reader {
-            Some(text) => with_prompt_warnings(diags, &source, text),
+            Some(nearest) => mprog::lang::with_far_prompts(diags, &source, nearest, FAR_COSINE),
             None => diags,
         };
         let ok = !diags.has_errors();

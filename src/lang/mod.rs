@@ -80,6 +80,39 @@ pub fn prompts_of(source: &str) -> Vec<(String, syntax::ast::Span)> {
     out
 }
 
+/// The caption a model knows that lies nearest a prompt, and their cosine similarity.
+pub type NearestCaption = dyn Fn(&str) -> Option<(String, f32)> + Send + Sync;
+
+/// `diags` with an `mprog::far_prompt` warning on every prompt of `source` whose nearest
+/// training caption (`nearest`, from the motion model's sentence encoder; the language
+/// itself knows no model) has a cosine below `far`.
+pub fn with_far_prompts(
+    diags: Diagnostics,
+    source: &str,
+    nearest: &NearestCaption,
+    far: f32,
+) -> Diagnostics {
+    let mut items = diags.items;
+    for (prompt, span) in prompts_of(source) {
+        if let Some((caption, cosine)) = nearest(&prompt)
+            && cosine < far
+        {
+            items.push(
+                Diagnostic::warning(
+                    codes::FAR_PROMPT,
+                    span,
+                    format!("the motion model was never trained on anything like \"{prompt}\""),
+                )
+                .label("far from every training caption")
+                .help(format!(
+                    "the prompt is far from every caption the model was trained on (cosine {cosine:.2} < {far}); nearest known: \"{caption}\"; the motion will follow the constraints more than the words. `mprog prompt` lists the actions the model knows"
+                )),
+            );
+        }
+    }
+    Diagnostics::new(&diags.name, diags.source, items)
+}
+
 /// Parses, checks and lowers a program. `overrides` replace `param` defaults (values in the
 /// unit the default was written in). Errors come back as [`Diagnostics`].
 pub fn compile(

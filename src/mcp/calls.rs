@@ -10,8 +10,15 @@ use serde_json::{Value, json};
 pub const SOURCE_NAME: &str = "program.mprog";
 
 /// `check`: what `mprog check --format json` prints for the program.
-pub fn check(source: &str, set: &[(String, f64)]) -> Value {
-    let diags = crate::lang::check_source(source, SOURCE_NAME, set);
+pub fn check(
+    source: &str,
+    set: &[(String, f64)],
+    far_prompts: Option<(&crate::lang::NearestCaption, f32)>,
+) -> Value {
+    let mut diags = crate::lang::check_source(source, SOURCE_NAME, set);
+    if let Some((nearest, far)) = far_prompts {
+        diags = crate::lang::with_far_prompts(diags, source, nearest, far);
+    }
     json!({
         "file": SOURCE_NAME,
         "ok": !diags.has_errors(),
@@ -108,7 +115,7 @@ mod tests {
 
     #[test]
     fn check_reports_located_diagnostics() {
-        let v = check("length 4s\nalways { r_hnad.y > 1 m }\n", &[]);
+        let v = check("length 4s\nalways { r_hnad.y > 1 m }\n", &[], None);
         assert_eq!(v["ok"], false);
         let d = &v["diagnostics"][0];
         assert_eq!(d["code"], crate::lang::codes::UNKNOWN_JOINT);
@@ -118,7 +125,7 @@ mod tests {
         );
         assert!(d["hint"].as_str().unwrap().contains("r_hand"));
         assert_eq!(
-            check("length 4s\nalways { head.y > 1 m }\n", &[])["ok"],
+            check("length 4s\nalways { head.y > 1 m }\n", &[], None)["ok"],
             true
         );
     }
@@ -150,5 +157,34 @@ mod tests {
             crate::lang::codes::UNKNOWN_JOINT,
             "{e}"
         );
+    }
+
+    #[test]
+    fn check_warns_on_a_prompt_far_from_the_models_captions() {
+        let nearest = |prompt: &str| -> Option<(String, f32)> {
+            let cosine = if prompt.contains("violin") { 0.31 } else { 0.8 };
+            Some(("a person waves".to_string(), cosine))
+        };
+        let far = check(
+            "prompt \"a person plays the violin\"\nlength 2s\nat end { head.y > 1 m }\n",
+            &[],
+            Some((&nearest, 0.5)),
+        );
+        let d = &far["diagnostics"][0];
+        assert_eq!(d["code"], crate::lang::codes::FAR_PROMPT);
+        assert_eq!(d["severity"], "warning");
+        assert!(
+            d["hint"]
+                .as_str()
+                .unwrap()
+                .contains("nearest known: \"a person waves\"")
+        );
+        assert_eq!(far["ok"], true, "a warning, not an error");
+        let near = check(
+            "prompt \"a person walks\"\nlength 2s\nat end { head.y > 1 m }\n",
+            &[],
+            Some((&nearest, 0.5)),
+        );
+        assert_eq!(near["diagnostics"].as_array().unwrap().len(), 0);
     }
 }

@@ -23,10 +23,11 @@ pub mod server;
 pub mod tools;
 
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
 /// How the server is set up.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Config {
     /// Where runs write and `score` reads.
     pub out_dir: PathBuf,
@@ -39,6 +40,25 @@ pub struct Config {
     /// The prompt card served as the MCP prompt and resource (None: the card without the
     /// model's action list); the CLI passes the one for the model runs use.
     pub card: Option<String>,
+    /// The nearest training caption of a prompt, with the cosine below which `check`
+    /// warns `mprog::far_prompt` (a sentence-encoder model's; the CLI passes it).
+    pub far_prompts: Option<(Arc<crate::lang::NearestCaption>, f32)>,
+}
+
+impl std::fmt::Debug for Config {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Config")
+            .field("out_dir", &self.out_dir)
+            .field("exe", &self.exe)
+            .field("model", &self.model)
+            .field("time_limit", &self.time_limit)
+            .field("card", &self.card.as_ref().map(String::len))
+            .field(
+                "far_prompts",
+                &self.far_prompts.as_ref().map(|(_, far)| far),
+            )
+            .finish()
+    }
 }
 
 /// The handler for `config`.
@@ -56,6 +76,7 @@ pub fn server(config: &Config) -> std::io::Result<server::Server> {
                 .clone()
                 .unwrap_or_else(crate::docgen::prompt::system_prompt),
         ),
+        far_prompts: config.far_prompts.clone(),
     })
 }
 
@@ -157,6 +178,7 @@ pub fn fuzz_one(data: &[u8]) -> Result<(), String> {
         model: None,
         time_limit: Duration::from_secs(2),
         card: None,
+        far_prompts: None,
     })
     .map_err(|e| e.to_string())?;
     let mut input = HANDSHAKE.as_bytes().to_vec();

@@ -27,6 +27,8 @@ pub struct Server {
     pub(super) runner: Arc<Runner>,
     /// The prompt card (with the model's actions when the CLI knows them).
     pub(super) card: Arc<String>,
+    /// Far-prompt warnings for `check` (see [`super::Config::far_prompts`]).
+    pub(super) far_prompts: Option<(Arc<crate::lang::NearestCaption>, f32)>,
 }
 
 fn text_result(v: &Value, error: bool) -> CallToolResult {
@@ -54,7 +56,8 @@ impl Server {
             "check" => {
                 let source = args::source(&a).map_err(bad)?;
                 let set = args::settings(&a, "set").map_err(bad)?;
-                text_result(&calls::check(&source, &set), false)
+                let far = self.far_prompts.as_ref().map(|(n, c)| (n.as_ref(), *c));
+                text_result(&calls::check(&source, &set, far), false)
             }
             "score" => {
                 let source = args::source(&a).map_err(bad)?;
