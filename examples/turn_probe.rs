@@ -41,7 +41,7 @@ fn main() {
     if let Ok(raw) = std::env::var("RAW") {
         let record = ModuleRecord::load(PathBuf::from(raw)).expect("training weights");
         bundle.model =
-            Mdm::new(&bundle.config, vocab_size(&bundle.text), &device).load_record(record);
+            Mdm::new(&bundle.config, bundle.text.vocab_size(), &device).load_record(record);
     }
     let data = Dataset::load(&PathBuf::from(&args[2])).expect("dataset");
     let clips: Vec<_> = data
@@ -156,12 +156,4 @@ fn main() {
         };
     }
     println!("final sample: {:.1}", turn(x));
-}
-
-/// Ids of a bag-of-words model's word table (none for a sentence model).
-fn vocab_size(text: &mprog::model::prompt::PromptEncoder) -> usize {
-    match text {
-        mprog::model::prompt::PromptEncoder::Words(v) => v.len(),
-        mprog::model::prompt::PromptEncoder::Sentences(_) => 0,
-    }
 }

@@ -115,10 +115,7 @@ fn bench_model(args: ModelBenchArgs) -> Result<()> {
             (config, PromptEncoder::Words(vocab), model)
         }
     };
-    let vocab_size = match &text {
-        PromptEncoder::Words(v) => v.len(),
-        PromptEncoder::Sentences(_) => 0,
-    };
+    let vocab_size = text.vocab_size();
     let n = args.frames;
     println!(
         "denoiser d_model {} × {} layers, {} params, {n} frames, {} backend on {}, median of {} runs\n",

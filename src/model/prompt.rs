@@ -124,6 +124,14 @@ pub enum PromptEncoder {
 }
 
 impl PromptEncoder {
+    /// Ids of the denoiser's word table (0 for a sentence model, which has none).
+    pub fn vocab_size(&self) -> usize {
+        match self {
+            PromptEncoder::Words(vocab) => vocab.len(),
+            PromptEncoder::Sentences(_) => 0,
+        }
+    }
+
     /// The text condition of `prompts`, one per sample.
     pub fn batch(&self, prompts: &[&str], device: &Device) -> TextBatch {
         match self {

@@ -188,10 +188,7 @@ impl ModelBundle {
             .check()
             .map_err(|e| mismatch(&config_path, format!("bad model config: {e}")))?;
         let text = load_prompt_encoder(dir, &config, &manifest, device)?;
-        let vocab_size = match &text {
-            PromptEncoder::Words(vocab) => vocab.len(),
-            PromptEncoder::Sentences(_) => 0,
-        };
+        let vocab_size = text.vocab_size();
         let stat = |name: &str| -> Result<Vec<f32>, WeightsError> {
             let p = dir.join(name);
             let (_, v) = read_f32_npy(&p, &[]).map_err(|e| mismatch(&p, e.to_string()))?;

@@ -187,6 +187,7 @@ impl ControlTrainRun<'_> {
         let stop_at = self
             .max_steps_now
             .map_or(cfg.steps, |n| (ck.state.step + n).min(cfg.steps));
+        let (mean, std) = (stat(&bundle.mean, &device), stat(&bundle.std, &device));
         let (mut pending, mut sum, mut count) = (String::new(), 0.0f64, 0usize);
         let mut clock = Instant::now();
         let mut saved_at = ck.state.step;
@@ -194,9 +195,7 @@ impl ControlTrainRun<'_> {
             let step = ck.state.step;
             let batch = draw_batch(self.data, &train, &batches, step);
             let (mut input, x0, valid) = to_device(&batch, &text, &device);
-            let mean = stat(&bundle.mean, &device);
-            let std = stat(&bundle.std, &device);
-            let joints = recover_from_ric_tensor(x0.clone() * std + mean);
+            let joints = recover_from_ric_tensor(x0.clone() * std.clone() + mean.clone());
             let lengths: Vec<usize> = batch
                 .padding
                 .chunks(batch.frames)
@@ -275,10 +274,7 @@ impl ControlTrainRun<'_> {
     fn frozen_base(&self, bundle: &ModelBundle, device: &Device) -> Result<Mdm, TrainError> {
         let path = self.base.join("model.safetensors");
         let bytes = std::fs::read(&path).map_err(|e| file_err(&path, e))?;
-        let vocab_size = match &bundle.text {
-            PromptEncoder::Words(v) => v.len(),
-            PromptEncoder::Sentences(_) => 0,
-        };
+        let vocab_size = bundle.text.vocab_size();
         let fresh = Mdm::new(&bundle.config, vocab_size, device);
         let base = model_from_safetensors(fresh, bytes, bundle.manifest.half_precision)
             .map_err(|e| file_err(&path, e))?;
