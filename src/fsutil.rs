@@ -39,6 +39,12 @@ pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomic(path, |w| w.write_all(bytes))
 }
 
+/// SHA-256 of a file's bytes, in hex: the provenance of a take in an output's meta.
+pub fn sha256_hex(path: &Path) -> io::Result<String> {
+    use sha2::{Digest, Sha256};
+    Ok(format!("{:x}", Sha256::digest(std::fs::read(path)?)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -183,10 +183,14 @@ fn bad_takes_windows_and_strengths_are_clear_errors_with_no_output() {
             "leaves no gap",
         ),
         (
-            vec![&prog, "--from", &one, "--solver", "latent"],
+            vec![&prog, "--from", &one, "--solver", "ik"],
             "cannot edit a take",
         ),
         (vec![&prog, "--strength", "0.5"], "--from"),
+        (
+            vec![&prog, "--from", &one, "--resample", "500"],
+            "more than 20 rounds",
+        ),
     ];
     for (args, want) in cases {
         let out_path = dir.path().join("out.json");

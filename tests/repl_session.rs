@@ -404,11 +404,22 @@ fn run_edits_the_take_loaded_with_motion() {
         assert!(a.iter().zip(b).all(|(p, q)| (*p - *q).length() < 1e-4));
     }
     assert!(fails(&mut s, ":run plain strength=1.5").contains("outside 0…1"));
-    assert!(fails(&mut s, ":run latent strength=0.5").contains("cannot edit a take"));
+    assert!(fails(&mut s, ":run ik strength=0.5").contains("cannot edit a take"));
     // A short edited chain runs, and `:gen` would end the editing.
     let out = say(
         &mut s,
         ":run guide 2 steps=10 k_late=20 late_steps=2 strength=0.5",
     );
     assert!(out.contains("at strength 0.5"), "{out}");
+    // The saved edit names the take, its hash and the strength.
+    let saved = dir.path().join("edited.json");
+    say(&mut s, &format!(":save {}", saved.display()));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&saved).unwrap()).unwrap();
+    let meta = &json["meta"];
+    let hash = mprog::fsutil::sha256_hex(&take).unwrap();
+    assert_eq!(meta["take"], take.display().to_string(), "{meta}");
+    assert_eq!(meta["take_sha256"], hash, "{meta}");
+    assert_eq!(meta["strength"], 0.5, "{meta}");
+    assert_eq!(meta["keep_path"], true, "{meta}");
 }

@@ -182,8 +182,11 @@ pub fn run(args: RunArgs) -> Result<()> {
             }
         }
     }
-    let plan = super::take::plan(&args.take, &program, bundle.config.max_frames)?;
-    let edit = plan.as_ref().map(|p| p.edit(&bundle.mean)).transpose()?;
+    let mut plan = super::take::plan(&args.take, &program, bundle.config.max_frames)?;
+    let edit = plan
+        .as_mut()
+        .map(|p| p.edit(&bundle.mean, &program))
+        .transpose()?;
     let frames = edit.as_ref().map_or(program.length(), |e| e.take.frames);
     let request = |solver: Solver| {
         let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver)

@@ -6,13 +6,16 @@
 //! Frames on the command line count the edit's frames: a take of F frames gives F − 1
 //! (HumanML3D's features drop the last frame), numbered 0 to F − 2.
 
+use burn::tensor::Device;
 use miette::{Result, miette};
 use mprog::formats::{LoadedMotion, Meta, read_motion};
 use mprog::lang::Program;
 use mprog::motion::Motion;
 use mprog::solve::take::frames_of;
-use mprog::solve::{DEFAULT_BLEND, DEFAULT_STRENGTH, Edit, Take, hold_weights};
-use sha2::{Digest, Sha256};
+use mprog::solve::{
+    DEFAULT_BLEND, DEFAULT_RESAMPLE, DEFAULT_STRENGTH, Edit, Take, auto_hold, hold_weights,
+    parts_joints,
+};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -42,11 +45,23 @@ pub struct TakeArgs {
     /// The inverse of `--keep`: only frames `a..b` change; the rest is held to the take.
     #[arg(long, requires = "from", value_name = "A..B", value_parser = parse_range)]
     pub edit: Option<RangeArg>,
-    /// Hold the take's path (root position and facing) on every frame and edit only the
-    /// body: the model otherwise walks its own way off the take's path. Leave it
-    /// off when the program must move the path.
-    #[arg(long, requires = "from", conflicts_with = "to")]
+    /// Hold the take's path (root position and facing) on every frame. By default the path
+    /// is held when the program's error does not change as the take moves sideways (a
+    /// program about the body's own shape), and free otherwise.
+    #[arg(long, requires = "from", conflicts_with_all = ["to", "free_path"])]
     pub keep_path: bool,
+    /// Let the path change even when the program is only about the body's shape.
+    #[arg(long, requires = "from", conflicts_with = "to")]
+    pub free_path: bool,
+    /// Let every body part change. By default the parts the program does not touch (torso,
+    /// head, each arm, each leg) keep the take's motion: a hand program leaves the legs, and
+    /// so the gait and the planted feet, as they were.
+    #[arg(long, requires = "from", conflicts_with = "to")]
+    pub free_body: bool,
+    /// RePaint resampling rounds at the seams of kept frames (default 5 when frames are kept
+    /// or an in-between is made, 0 otherwise); each round reruns the chain's steps once.
+    #[arg(long, requires = "from", value_name = "ROUNDS")]
+    pub resample: Option<usize>,
     /// Frames over which a kept window blends into the edited one at each seam.
     #[arg(long, requires = "from", value_name = "FRAMES", default_value_t = DEFAULT_BLEND)]
     pub blend: usize,
@@ -126,17 +141,21 @@ pub struct TakePlan {
     pub frames: usize,
     /// Blend frames at each seam.
     pub blend: usize,
-    /// Hold the take's path on every frame.
-    pub keep_path: bool,
+    /// Hold the take's path on every frame: `Some` when a flag says so, `None` to decide by
+    /// the program ([`auto_hold`]).
+    pub keep_path: Option<bool>,
+    /// Hold the body parts the program does not touch.
+    pub hold_body: bool,
+    /// Resampling rounds.
+    pub resample: usize,
     /// Provenance for the outputs' meta.
     pub meta: Meta,
 }
 
 /// SHA-256 of a file, hex.
 fn sha256(path: &Path) -> Result<String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| miette!("cannot read the take {}: {e}", path.display()))?;
-    Ok(format!("{:x}", Sha256::digest(&bytes)))
+    mprog::fsutil::sha256_hex(path)
+        .map_err(|e| miette!("cannot read the take {}: {e}", path.display()))
 }
 
 /// The people of a take file, with its hash.
@@ -182,6 +201,23 @@ fn read_take(path: &Path, people: usize) -> Result<(Vec<Motion>, String)> {
         ));
     }
     Ok((motions, hash))
+}
+
+/// Most resampling rounds `--resample` takes: each round reruns the chain once.
+pub const MAX_RESAMPLE: usize = 20;
+
+/// `--resample`, or `default`; refused above [`MAX_RESAMPLE`].
+fn resample_rounds(args: &TakeArgs, default: usize) -> Result<usize> {
+    let rounds = args.resample.unwrap_or(default);
+    if rounds > MAX_RESAMPLE {
+        return Err(miette!(
+            help = format!(
+                "each round reruns the chain once; {DEFAULT_RESAMPLE} closes the seams of a walk→run in-between"
+            ),
+            "--resample {rounds} is more than {MAX_RESAMPLE} rounds"
+        ));
+    }
+    Ok(rounds)
 }
 
 /// Checks the flags against the take files and the program, before the model loads.
@@ -253,7 +289,9 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
         ranges_json(&complement(&keep, frames)),
     );
     meta.insert("blend".into(), args.blend.into());
-    meta.insert("keep_path".into(), args.keep_path.into());
+    let resample = resample_rounds(args, if keep.is_empty() { 0 } else { DEFAULT_RESAMPLE })?;
+    meta.insert("resample".into(), resample.into());
+    meta.insert("foot_cleanup".into(), true.into());
     Ok(Some(TakePlan {
         people,
         after: None,
@@ -261,7 +299,13 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
         keep,
         frames,
         blend: args.blend,
-        keep_path: args.keep_path,
+        keep_path: match (args.keep_path, args.free_path) {
+            (true, _) => Some(true),
+            (_, true) => Some(false),
+            _ => None,
+        },
+        hold_body: !args.free_body,
+        resample,
         meta,
     }))
 }
@@ -334,6 +378,9 @@ fn plan_between(
         ranges_json(&complement(&keep, frames)),
     );
     meta.insert("blend".into(), args.blend.into());
+    let resample = resample_rounds(args, DEFAULT_RESAMPLE)?;
+    meta.insert("resample".into(), resample.into());
+    meta.insert("foot_cleanup".into(), true.into());
     Ok(TakePlan {
         people: before,
         after: Some(after_part),
@@ -341,7 +388,9 @@ fn plan_between(
         keep,
         frames,
         blend: args.blend,
-        keep_path: false,
+        keep_path: Some(false),
+        hold_body: false,
+        resample,
         meta,
     })
 }
@@ -374,8 +423,9 @@ fn complement(keep: &[Range<usize>], frames: usize) -> Vec<Range<usize>> {
 
 impl TakePlan {
     /// The library's edit: the take encoded (an in-between spliced around a gap of the
-    /// model's mean features `mean`), the hold weights of the kept windows.
-    pub fn edit(&self, mean: &[f32]) -> Result<Edit> {
+    /// model's mean features `mean`), the hold weights of the kept windows, and the path and
+    /// body parts held where `program` leaves them alone; what is held goes into the meta.
+    pub fn edit(&mut self, mean: &[f32], program: &Program) -> Result<Edit> {
         let encode = |people: &[Motion]| {
             Take::encode(people).map_err(|e| miette!("cannot encode the take: {e}"))
         };
@@ -385,16 +435,39 @@ impl TakePlan {
             take = Take::splice(&take, &b, self.frames, mean)
                 .ok_or_else(|| miette!("the in-between leaves no gap"))?;
         }
+        let auto = auto_hold(&take, program, &Device::flex())
+            .map_err(|e| miette!("cannot analyse the program on the take: {e}"))?;
+        let hold_path = self.keep_path.unwrap_or(auto.path);
+        let parts = if self.hold_body {
+            auto.parts
+        } else {
+            Vec::new()
+        };
+        eprintln!(
+            "editing the take: path {}; {} (--keep-path/--free-path, --free-body change this)",
+            if hold_path { "held" } else { "free" },
+            if parts.is_empty() {
+                "every body part free".to_string()
+            } else {
+                format!("held to the take: {}", parts.join(", "))
+            }
+        );
+        self.meta.insert("keep_path".into(), hold_path.into());
+        self.meta
+            .insert("held_parts".into(), serde_json::json!(parts));
         Ok(Edit {
-            take,
-            strength: self.strength,
             hold: if self.keep.is_empty() {
                 Vec::new()
             } else {
                 // An in-between's kept ranges already stop `blend` short of the gap.
                 hold_weights(self.frames, &self.keep, self.blend)
             },
-            hold_path: self.keep_path,
+            take,
+            strength: self.strength,
+            hold_path,
+            hold_joints: parts_joints(&parts),
+            resample: self.resample,
+            clean_feet: true,
         })
     }
 }

@@ -20,7 +20,9 @@ use crate::model::sampler::SamplerKind;
 use crate::motion::Motion;
 use crate::skeleton::FPS;
 use crate::solve::cleanup::{FootCleanup, clean_generated};
-use crate::solve::{DEFAULT_STRENGTH, Edit, Prior, SolveRequest, Solver, Take, solve};
+use crate::solve::{
+    BODY_PARTS, DEFAULT_STRENGTH, Edit, Prior, SolveRequest, Solver, Take, auto_hold, solve,
+};
 use burn::tensor::Device;
 use std::path::{Path, PathBuf};
 
@@ -41,6 +43,9 @@ pub struct CurrentMotion {
     pub people: Vec<Motion>,
     /// Where it came from (file name, or the `:gen` request).
     pub origin: String,
+    /// Provenance written into its outputs' meta: for a loaded take its path and hash,
+    /// for an edit also the strength and what was held.
+    pub provenance: crate::formats::Meta,
 }
 
 impl CurrentMotion {
@@ -148,6 +153,7 @@ impl Session {
         self.motion = Some(CurrentMotion {
             people,
             origin: origin.into(),
+            provenance: crate::formats::Meta::new(),
         });
     }
 
@@ -249,6 +255,13 @@ impl Session {
             },
         };
         self.set_motion(people, name);
+        if let Some(m) = self.motion.as_mut() {
+            m.provenance
+                .insert("take".into(), path.display().to_string().into());
+            if let Ok(hash) = crate::fsutil::sha256_hex(path) {
+                m.provenance.insert("take_sha256".into(), hash.into());
+            }
+        }
         self.take = self.motion.clone();
         Reply::text(format!(
             "{}\n`:run` now edits this take (`strength=S`, 0…1, default {DEFAULT_STRENGTH}); `:gen` ends that",
@@ -330,7 +343,7 @@ impl Session {
                 return Reply::error("`strength` edits a take: load one with `:motion FILE` first");
             }
             (None, None) => None,
-            (Some(take), s) => match take_edit(take, s.unwrap_or(DEFAULT_STRENGTH)) {
+            (Some(take), s) => match take_edit(take, s.unwrap_or(DEFAULT_STRENGTH), &program) {
                 Ok(e) => Some(e),
                 Err(e) => return Reply::error(e),
             },
@@ -338,12 +351,18 @@ impl Session {
         let frames = edit.as_ref().map_or(program.length(), |e| e.take.frames);
         let mut req =
             SolveRequest::new(prompts, frames, seed, solver.clone()).placed(program.placements());
+        let mut provenance = crate::formats::Meta::new();
         let origin = match (edit, &self.take) {
             (Some(e), Some(take)) => {
                 let s = e.strength;
+                let held = held_summary(&e);
+                provenance = take.provenance.clone();
+                provenance.insert("strength".into(), s.into());
+                provenance.insert("keep_path".into(), e.hold_path.into());
+                provenance.insert("held_parts".into(), serde_json::json!(held_parts(&e)));
                 req = req.editing(e);
                 format!(
-                    ":run {} seed {seed} editing {} at strength {s}",
+                    ":run {} seed {seed} editing {} at strength {s} ({held})",
                     solver.name(),
                     take.origin
                 )
@@ -362,6 +381,9 @@ impl Session {
                 let seconds = r.seconds;
                 let people = r.motions.into_iter().next().unwrap_or_default();
                 self.set_motion(people, origin);
+                if let Some(m) = self.motion.as_mut() {
+                    m.provenance = provenance;
+                }
                 let mut reply = Reply::text(format!(
                     "{} in {seconds:.1} s; {}",
                     solver.name(),
@@ -420,6 +442,7 @@ impl Session {
             Err(e) => return Reply::error(e),
         };
         meta.insert("origin".into(), m.origin.clone().into());
+        meta.extend(m.provenance.clone());
         let job = OutputJob {
             people: &m.people,
             meta: &meta,
@@ -500,9 +523,10 @@ impl Session {
     }
 }
 
-/// The edit of `take` at `strength`: every frame may change, none is kept (windows are
-/// `mprog run --keep`'s).
-fn take_edit(take: &CurrentMotion, strength: f32) -> Result<Edit, String> {
+/// The edit of `take` at `strength` by `program`: every frame may change, none is kept
+/// (windows are `mprog run --keep`'s); the path and the body parts the program does not
+/// touch are held ([`auto_hold`]).
+fn take_edit(take: &CurrentMotion, strength: f32, program: &Program) -> Result<Edit, String> {
     if !(strength.is_finite() && (0.0..=1.0).contains(&strength)) {
         return Err(format!(
             "strength {strength} is outside 0…1 (0 returns the take, 1 ignores it)"
@@ -510,12 +534,40 @@ fn take_edit(take: &CurrentMotion, strength: f32) -> Result<Edit, String> {
     }
     let take = Take::encode(&take.people)
         .map_err(|e| format!("cannot encode the take {}: {e}", take.origin))?;
+    let auto = auto_hold(&take, program, &Device::flex()).map_err(|e| e.to_string())?;
     Ok(Edit {
         take,
         strength,
         hold: Vec::new(),
-        hold_path: false,
+        hold_path: auto.path,
+        hold_joints: auto.joints(),
+        resample: 0,
+        clean_feet: true,
     })
+}
+
+/// The [`BODY_PARTS`] an edit holds.
+fn held_parts(e: &Edit) -> Vec<&'static str> {
+    BODY_PARTS
+        .iter()
+        .filter(|(_, joints)| joints.iter().all(|&j| e.hold_joints[j]))
+        .map(|(name, _)| *name)
+        .collect()
+}
+
+/// What an edit holds, in words: "path and legs held" style.
+fn held_summary(e: &Edit) -> String {
+    let parts = held_parts(e);
+    let path = if e.hold_path {
+        "path held"
+    } else {
+        "path free"
+    };
+    if parts.is_empty() {
+        format!("{path}, whole body free")
+    } else {
+        format!("{path}, held: {}", parts.join(", "))
+    }
 }
 
 /// Message when a command needs a motion.

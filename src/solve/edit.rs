@@ -24,12 +24,17 @@
 //! and [`Ctx::hold_final`]; with no take they change nothing.
 
 use super::SolveError;
+use super::cleanup::{FootCleanup, clean_feet};
 use super::request::{Phase, Progress};
-use super::run::Ctx;
+use super::run::{Ctx, host};
 use super::take::Take;
 use crate::features::FEATURE_DIM;
+use crate::features::layout::{CONTACT, LOCAL_VEL, RIC, ROOT_Y, ROT};
+use crate::model::noise::NoiseSource;
 use crate::model::sampler::{SamplerKind, ddim_step, guided_x0, posterior_mean, schedule_for};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use crate::objective::MotionError;
+use crate::skeleton::NUM_JOINTS;
 use burn::prelude::*;
 use std::ops::Range;
 
@@ -55,7 +60,36 @@ pub struct Edit {
     /// it (a real walk drifted 0.9–2.5 m sideways in 7 s); a program that must move the
     /// path ("go around the pillar") leaves this off.
     pub hold_path: bool,
+    /// Joints whose features are held to the take on every frame (MDM's body-part
+    /// editing): the program edits the rest. All `false`: the whole body is free. Build it
+    /// with [`auto_hold`] or [`parts_joints`].
+    pub hold_joints: [bool; NUM_JOINTS],
+    /// RePaint resampling rounds: every [`RESAMPLE_JUMP`] steps the chain is noised back up
+    /// that many steps and denoised again, this many times, so the free frames are
+    /// re-predicted next to the held ones and the seams agree. 0: off.
+    pub resample: usize,
+    /// Foot cleanup ([`clean_feet`]) of the result, on what is not held exactly: the
+    /// frames and parts the model made skate like its own samples (an in-between's gap
+    /// skated 1.6× the real clips), and `gen` cleans its samples the same way.
+    pub clean_feet: bool,
 }
+
+/// Resampling rounds when frames are kept and none are asked for (measured on a walk→run
+/// in-between: the book's editing chapter).
+pub const DEFAULT_RESAMPLE: usize = 5;
+
+/// Steps the chain goes back up at each resampling (RePaint's jump length).
+pub const RESAMPLE_JUMP: usize = 10;
+
+/// The body parts [`auto_hold`] holds or frees as a whole, with their joints.
+pub const BODY_PARTS: [(&str, &[usize]); 6] = [
+    ("torso", &[0, 3, 6, 9]),
+    ("head", &[12, 15]),
+    ("left arm", &[13, 16, 18, 20]),
+    ("right arm", &[14, 17, 19, 21]),
+    ("left leg", &[1, 4, 7, 10]),
+    ("right leg", &[2, 5, 8, 11]),
+];
 
 /// Path columns of a feature row: turning speed and horizontal velocity. Not the root
 /// height: the other joints' heights are the edited body's, and the take's pelvis height
@@ -91,6 +125,114 @@ pub fn hold_weights(frames: usize, keep: &[Range<usize>], blend: usize) -> Vec<f
 pub fn in_between_hold(frames: usize, context: usize, blend: usize) -> Vec<f32> {
     let inner = context.saturating_sub(blend);
     hold_weights(frames, &[0..inner, frames - inner..frames], blend)
+}
+
+/// The joints of the named [`BODY_PARTS`], held (`true`) or not.
+pub fn parts_joints(parts: &[&str]) -> [bool; NUM_JOINTS] {
+    let mut held = [false; NUM_JOINTS];
+    for (name, joints) in BODY_PARTS {
+        if parts.contains(&name) {
+            joints.iter().for_each(|&j| held[j] = true);
+        }
+    }
+    held
+}
+
+/// What an edit holds when the user does not say: see [`auto_hold`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct AutoHold {
+    /// The program's error does not change when the take moves sideways, so moving the
+    /// path cannot help it: the take's path is held.
+    pub path: bool,
+    /// The [`BODY_PARTS`] the program does not touch, held to the take.
+    pub parts: Vec<&'static str>,
+}
+
+impl AutoHold {
+    /// The held joints of [`Self::parts`].
+    pub fn joints(&self) -> [bool; NUM_JOINTS] {
+        parts_joints(&self.parts)
+    }
+}
+
+/// The default holds of an edit of `take` by `error`, found on the take itself:
+/// * a body part is held unless the error's gradient on the take reaches one of its joints
+///   (a hand-to-head program frees the arm and the head; legs, torso and the other arm keep
+///   the take's motion, so the walk stays the same walk and its feet stay planted);
+/// * the path is held unless shifting the whole take sideways changes the error (a program
+///   about where the body is, such as a region or a target point, may move the path; one
+///   about the body's own shape may not).
+///
+/// A program the take already meets touches nothing, and the edit returns the take.
+pub fn auto_hold(
+    take: &Take,
+    error: &dyn MotionError,
+    device: &Device,
+) -> Result<AutoHold, SolveError> {
+    let people = take
+        .motions()
+        .map_err(|e| SolveError::Invalid(format!("cannot decode the take: {e}")))?;
+    let n = take.frames;
+    let flat: Vec<f32> = people.iter().flat_map(|m| m.to_flat()).collect();
+    let dims = [1, people.len(), n, NUM_JOINTS, 3];
+    let ad = device.clone().autodiff();
+    let joints = Tensor::<5>::from_data(TensorData::new(flat.clone(), dims), &ad).require_grad();
+    let e = error.error(joints.clone());
+    let mut touched = [false; NUM_JOINTS];
+    let grad = e
+        .is_tracked()
+        .then(|| joints.grad(&e.sum().backward()))
+        .flatten();
+    if let Some(g) = grad {
+        let per_joint = host(
+            g.abs()
+                .sum_dim(4)
+                .sum_dim(2)
+                .sum_dim(1)
+                .reshape([NUM_JOINTS]),
+        );
+        for (t, g) in touched.iter_mut().zip(per_joint) {
+            *t = g > 0.0 || !g.is_finite();
+        }
+    }
+    let total = |offset: [f32; 3]| -> f32 {
+        let moved: Vec<f32> = flat
+            .chunks_exact(3)
+            .flat_map(|p| [p[0] + offset[0], p[1] + offset[1], p[2] + offset[2]])
+            .collect();
+        let j = Tensor::<5>::from_data(TensorData::new(moved, dims), device);
+        error.error(j).sum().into_scalar::<f32>()
+    };
+    let here = total([0.0; 3]);
+    let same = |v: f32| (v - here).abs() <= 1e-5 * (1.0 + here.abs());
+    let path = same(total([0.73, 0.0, -0.41])) && same(total([-1.9, 0.0, 2.3]));
+    let parts = BODY_PARTS
+        .iter()
+        .filter(|(_, joints)| !joints.iter().any(|&j| touched[j]))
+        .map(|(name, _)| *name)
+        .collect();
+    Ok(AutoHold { path, parts })
+}
+
+/// The feature columns that belong to joint `j`: its root-relative position and rotation,
+/// its velocity, its foot contact, and for the pelvis the root height.
+fn joint_columns(j: usize) -> Vec<usize> {
+    let mut cols = vec![
+        LOCAL_VEL.start + 3 * j,
+        LOCAL_VEL.start + 3 * j + 1,
+        LOCAL_VEL.start + 3 * j + 2,
+    ];
+    if j == 0 {
+        cols.extend(ROOT_Y);
+    } else {
+        cols.extend(RIC.start + 3 * (j - 1)..RIC.start + 3 * j);
+        cols.extend(ROT.start + 6 * (j - 1)..ROT.start + 6 * j);
+    }
+    // HumanML3D's contact columns: left ankle, left foot, right ankle, right foot.
+    if let Some(k) = [7, 10, 8, 11].iter().position(|&f| f == j) {
+        cols.push(CONTACT.start + k);
+    }
+    cols
 }
 
 impl Edit {
@@ -139,6 +281,8 @@ impl Edit {
 /// hold weights broadcast to `[B·P, N, 263]`.
 pub struct EditState {
     strength: f32,
+    resample: usize,
+    clean_feet: bool,
     /// `[B·P, N, 263]` normalised take.
     take: Tensor<3>,
     /// `[B·P, N, 263]` hold weights (`None`: nothing kept).
@@ -166,18 +310,21 @@ impl EditState {
         let motions = samples * edit.take.features.len();
         let dims = [motions, n, FEATURE_DIM];
         let take = Tensor::from_data(TensorData::new(x, dims), device);
-        let held = !edit.hold.is_empty() || edit.hold_path;
-        // `[N, 263]`: the frame's weight, 1 on the path columns when the path is held.
+        let body = edit.hold_joints.iter().any(|h| *h);
+        let held = !edit.hold.is_empty() || edit.hold_path || body;
+        // `[263]`: 1 on the columns held on every frame (the path, the held joints).
+        let mut always = vec![0.0f32; FEATURE_DIM];
+        if edit.hold_path {
+            always[..PATH_COLUMNS].fill(1.0);
+        }
+        for j in (0..NUM_JOINTS).filter(|&j| edit.hold_joints[j]) {
+            joint_columns(j).into_iter().for_each(|c| always[c] = 1.0);
+        }
+        // `[N, 263]`: the larger of the frame's weight and the column's.
         let weights: Vec<f32> = (0..if held { n } else { 0 })
             .flat_map(|t| {
                 let w = edit.hold.get(t).copied().unwrap_or(0.0);
-                (0..FEATURE_DIM).map(move |c| {
-                    if edit.hold_path && c < PATH_COLUMNS {
-                        1.0
-                    } else {
-                        w
-                    }
-                })
+                always.iter().map(move |a| a.max(w))
             })
             .collect();
         let free = weights.iter().map(|w| 1.0 - w).collect();
@@ -192,11 +339,119 @@ impl EditState {
         let hold = held.then(|| broadcast(weights));
         EditState {
             strength: edit.strength,
+            resample: edit.resample,
+            clean_feet: edit.clean_feet,
             take,
             hold,
             exact,
             free,
         }
+    }
+}
+
+impl EditState {
+    /// The edit's foot cleanup on the denormalised `[B·P, N, 263]` result (`frames` per
+    /// motion), when it asks for one: what is held (kept frames, held columns) is put
+    /// back afterwards, so only what the model made is touched.
+    pub fn clean_free_feet(&self, features: &mut [f32], frames: usize) {
+        if !self.clean_feet || self.strength == 0.0 {
+            return;
+        }
+        let before = features.to_vec();
+        clean_feet(features, frames, FEATURE_DIM, &FootCleanup::default());
+        // By the hold weights: held exactly where they are 1, eased over the seams' blend
+        // frames (restoring only the exact frames let a cleaned seam frame jump 1 mm more
+        // than the clips of a walk→run in-between).
+        if let Some(hold) = &self.hold {
+            let hold = host(hold.clone());
+            for ((f, b), w) in features.iter_mut().zip(&before).zip(&hold) {
+                *f += (b - *f) * w;
+            }
+        }
+    }
+}
+
+/// The take and the hold weights of an edit on one device: [`Ctx::hold_x0`] for chains
+/// that run elsewhere than the context's device.
+#[derive(Clone)]
+pub struct X0Hold {
+    take: Tensor<3>,
+    w: Tensor<3>,
+}
+
+impl X0Hold {
+    /// x̂0 with the held frames and columns replaced by the take's (differentiable in x̂0).
+    pub fn apply(&self, x0: Tensor<3>) -> Tensor<3> {
+        x0.clone() + (self.take.clone() - x0) * self.w.clone()
+    }
+}
+
+/// The steps of a chain, in the order they run: `first − 1` down to 0, except that with
+/// `rounds` of resampling each block of [`RESAMPLE_JUMP`] steps (but the last) is run
+/// `rounds` more times, the chain noised back up to the block's top before each rerun
+/// (RePaint, Lugmayr et al. 2022, with jump length 10).
+pub struct ChainSteps {
+    next: usize,
+    first: usize,
+    rounds: usize,
+    resampled: Vec<usize>,
+    ran: usize,
+}
+
+impl ChainSteps {
+    /// The steps of a chain that starts at `first`.
+    pub fn new(first: usize, rounds: usize) -> Self {
+        ChainSteps {
+            next: first,
+            first,
+            rounds,
+            resampled: vec![0; first / RESAMPLE_JUMP + 1],
+            ran: 0,
+        }
+    }
+
+    /// Steps the chain runs in all, reruns included.
+    pub fn total(&self) -> usize {
+        self.first
+            + self.rounds
+                * (self.first.saturating_sub(RESAMPLE_JUMP) / RESAMPLE_JUMP)
+                * RESAMPLE_JUMP
+    }
+
+    /// Steps run so far.
+    pub fn ran(&self) -> usize {
+        self.ran
+    }
+
+    /// The index of the next step to run, or `None` at the end of the chain.
+    pub fn next_step(&mut self) -> Option<usize> {
+        self.next = self.next.checked_sub(1)?;
+        self.ran += 1;
+        Some(self.next)
+    }
+
+    /// `x` after the step just run, or noised back up to the top of its block when the
+    /// block is due another round: `x_b = √(ᾱ_b/ᾱ_a)·x_a + √(1 − ᾱ_b/ᾱ_a)·ε`.
+    pub fn after(
+        &mut self,
+        schedule: &NoiseSchedule,
+        x: Tensor<3>,
+        noise: &mut NoiseSource,
+        device: &Device,
+    ) -> Tensor<3> {
+        let (i, jump) = (self.next, RESAMPLE_JUMP);
+        if self.rounds == 0 || i == 0 || i % jump != 0 || i + jump > self.first {
+            return x;
+        }
+        let block = &mut self.resampled[i / jump];
+        if *block >= self.rounds {
+            return x;
+        }
+        *block += 1;
+        let ratio = schedule.alphas_cumprod[i + jump - 1] / schedule.alphas_cumprod[i - 1];
+        self.next = i + jump;
+        let dims = x.dims();
+        x * ratio.sqrt() as f32 + noise.tensor(dims, device) * (1.0 - ratio).sqrt() as f32
     }
 }
 
@@ -219,6 +474,62 @@ impl Ctx<'_> {
         let x = edit.take.clone() * a.sqrt() as f32
             + self.initial_tensor(&self.device) * (1.0 - a).sqrt() as f32;
         (k, x)
+    }
+
+    /// Where `latent`'s chain starts: the steps to run and z, x at the first of them.
+    /// Without a take, or at strength 1: every step, from the seeded noise. With one: the
+    /// take inverted by deterministic DDIM ([`Ctx::invert_take`]) to the strength's level,
+    /// so the chain run from z gives back (close to) the take before any optimisation.
+    pub fn latent_start(&self, schedule: &NoiseSchedule) -> (usize, Tensor<3>) {
+        let n = schedule.len();
+        match &self.edit {
+            Some(edit) if edit.strength < 1.0 => {
+                let k = ((edit.strength as f64 * n as f64).round() as usize).min(n);
+                (k, self.invert_take(schedule, k))
+            }
+            _ => (n, self.initial_tensor(&self.device)),
+        }
+    }
+
+    /// DDIM inversion (η = 0) of the take up to level `first − 1` of `schedule`, the x
+    /// from which a DDIM chain of `first` steps returns to the take. Each step reads the
+    /// model's x̂0 at the next level's timestep from the current x (the usual approximation,
+    /// as in guided-diffusion's `ddim_reverse_sample` that DNO uses):
+    /// `ε = (x − √ᾱᵢ·x̂0)/√(1 − ᾱᵢ)`, `x ← √ᾱᵢ₊₁·x̂0 + √(1 − ᾱᵢ₊₁)·ε`.
+    /// `first` 0 is the take itself. The take's held frames and columns (`hold_x0`) are
+    /// the take's own, so inverting them changes nothing.
+    pub fn invert_take(&self, schedule: &NoiseSchedule, first: usize) -> Tensor<3> {
+        let Some(edit) = &self.edit else {
+            return self.initial_tensor(&self.device);
+        };
+        let den = self.denoiser();
+        let cond = self.condition(&self.device);
+        let mut x = edit.take.clone();
+        for i in 0..first.saturating_sub(1) {
+            let x0 = guided_x0(&den, x.clone(), schedule.timesteps[i], &cond);
+            let (a, b) = (schedule.alphas_cumprod[i], schedule.alphas_cumprod[i + 1]);
+            let eps = (x - x0.clone() * a.sqrt() as f32) / (1.0 - a).sqrt() as f32;
+            x = x0 * b.sqrt() as f32 + eps * (1.0 - b).sqrt() as f32;
+        }
+        x
+    }
+
+    /// [`Ctx::hold_x0`] for a chain on `device` (an autodiff one for `latent`): the take
+    /// and the hold weights moved there, or `None` when nothing is held.
+    pub fn x0_hold_on(&self, device: &Device) -> Option<X0Hold> {
+        let edit = self.edit.as_ref()?;
+        let w = edit.hold.clone()?;
+        Some(X0Hold {
+            take: Tensor::from_data(edit.take.clone().into_data(), device),
+            w: Tensor::from_data(w.into_data(), device),
+        })
+    }
+
+    /// The order of a chain's steps from [`Ctx::chain_start`]'s `first`: straight down
+    /// without a take, with the edit's resampling rounds when it has some.
+    pub fn chain_steps(&self, first: usize) -> ChainSteps {
+        let rounds = self.edit.as_ref().map_or(0, |e| e.resample);
+        ChainSteps::new(first, rounds)
     }
 
     /// The model's x̂0 with kept frames replaced by the take (unchanged without one).
@@ -274,7 +585,8 @@ impl Ctx<'_> {
         let mut noise = self.step_noise();
         let dims = self.dims();
         let (first, mut x) = self.chain_start(&schedule);
-        for i in (0..first).rev() {
+        let mut steps = self.chain_steps(first);
+        while let Some(i) = steps.next_step() {
             let x0 = self.hold_x0(guided_x0(&den, x.clone(), schedule.timesteps[i], &cond));
             x = match kind {
                 SamplerKind::Ddim(_) => ddim_step(&schedule, i, x, x0),
@@ -288,10 +600,11 @@ impl Ctx<'_> {
                     }
                 }
             };
+            x = steps.after(&schedule, x, &mut noise, &self.device);
             progress(Progress {
                 phase: Phase::Sampling,
-                done: first - i,
-                total: first,
+                done: steps.ran(),
+                total: steps.total(),
                 error: None,
             });
         }

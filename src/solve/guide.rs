@@ -239,7 +239,8 @@ fn run(
     let (n, mut x) = ctx.chain_start(&schedule);
     let mut trace = Vec::with_capacity(n);
     let mut realism = Realism::new(ctx, ctx.prior.control.filter(|_| cfg.realism));
-    for i in (0..n).rev() {
+    let mut steps = ctx.chain_steps(n);
+    while let Some(i) = steps.next_step() {
         let x0 = ctx.hold_x0(realism.x0(&den, x.clone(), schedule.timesteps[i], &cond));
         let mut mu = posterior_mean(&schedule, i, x, x0);
         let k = cfg.iterations_at(i);
@@ -274,10 +275,11 @@ fn run(
         } else {
             mu
         };
+        x = steps.after(&schedule, x, &mut noise, &ctx.device);
         progress(Progress {
             phase: Phase::Sampling,
-            done: n - i,
-            total: n,
+            done: steps.ran(),
+            total: steps.total(),
             error: last,
         });
     }

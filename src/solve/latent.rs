@@ -26,6 +26,11 @@
 //! ([`HostObjective::set_rigid`](super::host::HostObjective::set_rigid)). Without the
 //! skeleton the rigid move is differentiated through the burn decoder.
 //!
+//! Editing a take (DNO's editing): z starts from the take inverted by deterministic DDIM
+//! to the strength's level ([`Ctx::latent_start`]), the chain runs only the steps below
+//! it, and every x̂0 of the chain has the edit's held frames and columns put in
+//! ([`X0Hold`]), so the gradient reaches z only through what the edit may change.
+//!
 //! Memory: with [`LatentConfig::checkpoint`] off (the default, as PMG), the graph of the
 //! whole chain (steps × 2 CFG passes) is kept for one backward (measured: 1519 MiB peak RSS
 //! at 100 steps, 120 frames, one motion; it grows with B·P). With it on, the forward runs
@@ -47,6 +52,7 @@ use super::request::{Phase, Progress};
 use super::run::{Ctx, Outcome, ensure_finite, host, mean};
 use super::{SolveError, host::check_shape};
 use crate::features::FEATURE_DIM;
+use super::edit::X0Hold;
 use crate::model::sampler::{Condition, ddim_step, guided_x0};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::model::{Denoiser, Mdm};
@@ -136,32 +142,61 @@ pub fn ddim_chain(
     z: Tensor<3>,
     cond: &Condition,
 ) -> Tensor<3> {
+    ddim_chain_from(den, schedule, schedule.len(), z, cond, None)
+}
+
+/// [`ddim_chain`] over the steps `first − 1` down to 0 only (an edit starts part-way),
+/// with an edit's held frames and columns put into every x̂0.
+fn ddim_chain_from(
+    den: &impl Denoiser,
+    schedule: &NoiseSchedule,
+    first: usize,
+    z: Tensor<3>,
+    cond: &Condition,
+    hold: Option<&X0Hold>,
+) -> Tensor<3> {
     let mut x = z;
-    for i in (0..schedule.len()).rev() {
-        let x0 = guided_x0(den, x.clone(), schedule.timesteps[i], cond);
-        x = ddim_step(schedule, i, x, x0);
+    for i in (0..first).rev() {
+        x = ddim_step_held(den, schedule, i, x, cond, hold);
     }
     x
 }
 
+/// One DDIM step, x̂0 held where an edit holds it.
+fn ddim_step_held(
+    den: &impl Denoiser,
+    schedule: &NoiseSchedule,
+    i: usize,
+    x: Tensor<3>,
+    cond: &Condition,
+    hold: Option<&X0Hold>,
+) -> Tensor<3> {
+    let x0 = guided_x0(den, x.clone(), schedule.timesteps[i], cond);
+    let x0 = match hold {
+        Some(h) => h.apply(x0),
+        None => x0,
+    };
+    ddim_step(schedule, i, x, x0)
+}
+
 /// Back-propagates `g = ∂E/∂x̂` through the DDIM steps one at a time: `inputs[k]` is the
-/// input of the k-th step run (the chain's first step first); each step is re-run with
-/// autodiff and `⟨step(x), g⟩` differentiated. Returns ∂E/∂z.
+/// input of the k-th step run (the chain's first step, `first − 1`, first); each step is
+/// re-run with autodiff and `⟨step(x), g⟩` differentiated. Returns ∂E/∂z.
 fn backprop_steps(
     model: &Mdm,
     schedule: &NoiseSchedule,
     cond: &Condition,
+    hold: Option<&X0Hold>,
     inputs: Vec<Tensor<3>>,
     mut g: Vec<f32>,
     ad: &Device,
 ) -> Vec<f32> {
-    let n = schedule.len();
+    let first = inputs.len();
     for (k, input) in inputs.into_iter().enumerate().rev() {
-        let i = n - 1 - k;
+        let i = first - 1 - k;
         let dims = input.dims();
         let xi = Tensor::<3>::from_data(input.into_data(), ad).require_grad();
-        let x0 = guided_x0(model, xi.clone(), schedule.timesteps[i], cond);
-        let out = ddim_step(schedule, i, xi.clone(), x0);
+        let out = ddim_step_held(model, schedule, i, xi.clone(), cond, hold);
         let up = Tensor::<3>::from_data(TensorData::new(g, dims), ad);
         let grads = (out * up).sum().backward();
         g = xi
@@ -190,13 +225,19 @@ fn run(
     let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS).respaced(cfg.ddim_steps);
     let dims = ctx.dims();
     let m = ctx.motions();
-    let mut z = ctx.initial_noise();
+    // An edit starts from its take inverted to the strength's level; strength 0 (no steps)
+    // has nothing to optimise and returns the take.
+    let (first, z0) = ctx.latent_start(&schedule);
+    let iterations = if first == 0 { 1 } else { cfg.iterations };
+    let mut z = host(z0);
+    let hold_ad = ctx.x0_hold_on(&ad);
+    let hold_plain = ctx.x0_hold_on(&ctx.device);
     let mut adam = Adam::new(z.len(), cfg.lr);
     let relax = cfg.relax == Relax::RigidXz;
     // [yaw; x; z] × motions.
     let mut rigid = vec![0.0f32; 3 * m];
     let mut adam_rigid = Adam::new(rigid.len(), cfg.relax_lr);
-    let mut trace = Vec::with_capacity(cfg.iterations);
+    let mut trace = Vec::with_capacity(iterations);
     let mut last = Vec::new();
     let plain_model = ctx.denoiser();
     let plain_cond = ctx.condition(&ctx.device);
@@ -215,22 +256,29 @@ fn run(
     let pull = ReferencePull::new(cfg.ref_root, cfg.ref_legs);
     // The chain's raw output at iteration 0, which the pull holds the later ones to.
     let mut reference: Option<Vec<f32>> = None;
-    for it in 0..cfg.iterations {
-        let at = || format!("iteration {}/{}", it + 1, cfg.iterations);
+    for it in 0..iterations {
+        let at = || format!("iteration {}/{}", it + 1, iterations);
         let zt = Tensor::<3>::from_data(TensorData::new(z.clone(), dims), &ad).require_grad();
         // Forward: the whole graph, or a plain chain keeping each step's input.
         let (x, inputs) = if cfg.checkpoint {
-            let mut xs = Vec::with_capacity(schedule.len());
+            let mut xs = Vec::with_capacity(first);
             let mut xi = Tensor::<3>::from_data(TensorData::new(z.clone(), dims), &ctx.device);
-            for i in (0..schedule.len()).rev() {
+            for i in (0..first).rev() {
                 xs.push(xi.clone());
-                let x0 = guided_x0(&plain_model, xi.clone(), schedule.timesteps[i], &plain_cond);
-                xi = ddim_step(&schedule, i, xi, x0);
+                xi = ddim_step_held(
+                    &plain_model,
+                    &schedule,
+                    i,
+                    xi,
+                    &plain_cond,
+                    hold_plain.as_ref(),
+                );
             }
             let leaf = Tensor::<3>::from_data(xi.into_data(), &ad).require_grad();
             (leaf, xs)
         } else {
-            (ddim_chain(&model, &schedule, zt.clone(), &cond), Vec::new())
+            let x = ddim_chain_from(&model, &schedule, first, zt.clone(), &cond, hold_ad.as_ref());
+            (x, Vec::new())
         };
         // With the skeleton the rigid move is differentiated on the host, else in burn.
         let rt = (relax && !skeleton).then(|| {
@@ -279,11 +327,11 @@ fn run(
         progress(Progress {
             phase: Phase::Optimising,
             done: it + 1,
-            total: cfg.iterations,
+            total: iterations,
             error: Some(mean(&values)),
         });
         trace.push(values);
-        if it + 1 == cfg.iterations || !e.is_tracked() {
+        if it + 1 == iterations || !e.is_tracked() {
             break;
         }
         let mut loss = e.sum();
@@ -302,7 +350,7 @@ fn run(
                 .grad(&grads)
                 .map(host)
                 .unwrap_or_else(|| vec![0.0; z.len()]);
-            backprop_steps(&model, &schedule, &cond, inputs, g, &ad)
+            backprop_steps(&model, &schedule, &cond, hold_ad.as_ref(), inputs, g, &ad)
         } else {
             zt.grad(&grads)
                 .map(host)
@@ -329,6 +377,10 @@ fn run(
         }
     }
     let relax = relax.then(|| placements(&rigid));
+    if ctx.edit.is_some() {
+        let x = Tensor::<3>::from_data(TensorData::new(last, dims), &ctx.device);
+        last = host(ctx.hold_final(x));
+    }
     Ok(Outcome {
         x: last,
         relax,
@@ -390,6 +442,6 @@ impl SolverConfig for LatentConfig {
         run(ctx, self, progress)
     }
     fn edit_refusal(&self) -> Option<&'static str> {
-        Some("it optimises the noise of a DDIM chain, and inverting a take to its noise (DDIM inversion) is not implemented")
+        None
     }
 }

@@ -98,7 +98,10 @@ mod tests;
 
 pub use crate::scene::{DEFAULT_SPACING, Placement};
 pub use decode::{Decoder, RigidTensors};
-pub use edit::{DEFAULT_BLEND, DEFAULT_STRENGTH, Edit, hold_weights, in_between_hold};
+pub use edit::{
+    AutoHold, BODY_PARTS, DEFAULT_BLEND, DEFAULT_RESAMPLE, DEFAULT_STRENGTH, Edit, auto_hold,
+    hold_weights, in_between_hold, parts_joints,
+};
 pub use guide::{GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;
 pub use knobs::{KnobKind, KnobValue};

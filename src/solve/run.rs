@@ -273,6 +273,9 @@ fn finish(
             *v = *v * s + m;
         }
     }
+    if let Some(edit) = &ctx.edit {
+        edit.clean_free_feet(&mut features, ctx.frames);
+    }
     let per = ctx.frames * FEATURE_DIM;
     let mut motions = Vec::with_capacity(ctx.samples);
     let mut world = Vec::with_capacity(ctx.samples);
