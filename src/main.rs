@@ -56,35 +56,8 @@ enum Command {
     Doc(cli::doc::DocCommand),
 }
 
-/// glibc hands every freed block above 128 KiB back to the kernel, so each training step,
-/// sampling step or solver iteration faults its activations in again as fresh zeroed pages:
-/// 52,000 page faults a second and a third of the CPU in the kernel while training (measured
-/// on the 2-core machine). Keeping blocks up to 32 MiB (the largest glibc allows for this)
-/// on the heap, and not trimming it, reuses them instead. glibc's own settings win: with
-/// any `MALLOC_*_` variable or `GLIBC_TUNABLES` set nothing is changed (so
-/// `MALLOC_TOP_PAD_=131072`, glibc's default, measures the untuned allocator).
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn tune_allocator() {
-    let user_set = std::env::vars_os().any(|(k, _)| {
-        let k = k.to_string_lossy();
-        k == "GLIBC_TUNABLES" || (k.starts_with("MALLOC_") && k.ends_with('_'))
-    });
-    if user_set {
-        return;
-    }
-    // SAFETY: mallopt only sets allocator parameters; called before any other thread exists.
-    unsafe {
-        libc::mallopt(libc::M_MMAP_THRESHOLD, 32 << 20);
-        libc::mallopt(libc::M_TRIM_THRESHOLD, 1 << 30);
-        libc::mallopt(libc::M_TOP_PAD, 256 << 20);
-    }
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn tune_allocator() {}
-
 fn main() -> miette::Result<()> {
-    tune_allocator();
+    mprog::backend::tune_allocator();
     let cli = Cli::parse();
     match cli.command {
         Command::Joints => print_joints(),

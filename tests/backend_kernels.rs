@@ -282,3 +282,56 @@ fn a_seeded_dropout_mask_repeats() {
     // Blocks are seeded apart: the second 64K block is not a copy of the first.
     assert_ne!(a[..1000], a[65_536..66_536]);
 }
+
+#[test]
+fn strided_and_broadcast_operands_and_slice_writes_are_exact() {
+    // One coordinate of `[B, N, J, 3]` joints (a stride-3 view) against a broadcast
+    // scalar, a broadcast row, another strided view and itself broadcast; then the
+    // backward of that slice (a write of the last dim's column into zeros).
+    let dev = Device::flex().autodiff();
+    let (b, n, j) = (4, 50, 22);
+    let v = random(b * n * j * 3, -2.0, 2.0, 11);
+    let joints =
+        Tensor::<4>::from_data(TensorData::new(v.clone(), [b, n, j, 3]), &dev).require_grad();
+    let x = joints.clone().slice([0..b, 0..n, 0..j, 0..1]);
+    let z = joints.clone().slice([0..b, 0..n, 0..j, 2..3]);
+    let half = Tensor::<4>::from_data(TensorData::new(vec![0.5f32], [1, 1, 1, 1]), &dev);
+    let row = Tensor::<4>::from_data(
+        TensorData::new(random(j, -1.0, 1.0, 12), [1, 1, j, 1]),
+        &dev,
+    );
+    let flat = |t: Tensor<4>| t.into_data().try_into_vec::<f32>().unwrap();
+    let at = |k: usize, c: usize| v[k * 3 + c];
+    let rows = b * n * j;
+    let got = flat(x.clone() - half.clone());
+    assert!((0..rows).all(|k| got[k] == at(k, 0) - 0.5));
+    let got = flat(half.clone() - x.clone());
+    assert!((0..rows).all(|k| got[k] == 0.5 - at(k, 0)));
+    let got = flat(x.clone() * z.clone());
+    assert!((0..rows).all(|k| got[k] == at(k, 0) * at(k, 2)));
+    let r = flat(row.clone());
+    let got = flat(z.clone() - row.clone());
+    assert!((0..rows).all(|k| got[k] == at(k, 2) - r[k % j]));
+    // Both operands broadcast along the innermost dim: a stride-0 pair.
+    let col =
+        |seed| Tensor::<2>::from_data(TensorData::new(random(5, -1.0, 1.0, seed), [5, 1]), &dev);
+    let (p, q) = (col(13), col(14));
+    let (pv, qv) = (
+        p.clone().into_data().try_into_vec::<f32>().unwrap(),
+        q.clone().into_data().try_into_vec::<f32>().unwrap(),
+    );
+    let got = (p.expand([5, 7]) - q.expand([5, 7]))
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap();
+    assert!((0..35).all(|k| got[k] == pv[k / 7] - qv[k / 7]));
+    // ∂/∂joints of Σ 2·x + 3·z: 2 on the x column, 3 on the z column, 0 on y.
+    let loss = (x * 2.0).sum() + (z * 3.0).sum();
+    let g = joints.grad(&loss.backward()).unwrap();
+    let g = g.into_data().try_into_vec::<f32>().unwrap();
+    assert!(
+        g.chunks_exact(3).all(|c| c == [2.0, 0.0, 3.0]),
+        "{:?}",
+        &g[..6]
+    );
+}

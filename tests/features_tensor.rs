@@ -163,6 +163,7 @@ fn time_ms(runs: usize, mut f: impl FnMut()) -> f64 {
 #[test]
 #[ignore = "timing table, run by hand"]
 fn recover_timings() {
+    mprog::backend::tune_allocator();
     let n = 196;
     println!("| B | fwd (flex) | fwd (flex+autodiff) | fwd+bwd of Σ(J−T)² |");
     println!("| --- | --- | --- | --- |");

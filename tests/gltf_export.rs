@@ -46,7 +46,7 @@ fn convert_writes_a_glb_through_the_output_table() {
 /// Blender imports our glTF and its joint empties sit within 1 cm of the input:
 /// `cargo test --test gltf_export -- --ignored --nocapture blender`.
 #[test]
-#[ignore = "needs Blender (apt-get install blender); run by hand"]
+#[ignore = "needs Blender (apt-get install blender python3-numpy); run by hand"]
 fn blender_imports_the_glb_where_we_expect() {
     if Command::new("blender").arg("--version").output().is_err() {
         println!("SKIPPED: blender is not installed");

@@ -29,6 +29,8 @@ fn time(runs: usize, mut f: impl FnMut()) -> f64 {
 #[test]
 #[ignore]
 fn bench_programs() {
+    // Time what the binary runs: `mprog` tunes glibc's allocator first thing.
+    mprog::backend::tune_allocator();
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("programs");
     let mut files: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
@@ -39,8 +41,14 @@ fn bench_programs() {
         "| program | stmts | ops | eval B=1 µs | eval+grad B=1 µs | eval B=32 µs | eval+grad B=32 µs |"
     );
     println!("|---|---|---|---|---|---|---|");
+    // `MPROG_BENCH_ONLY=hsc1` times only the programs whose name contains it, and
+    // `MPROG_BENCH_REPEAT=k` runs each timing k times as often (for a profiler).
+    let only = std::env::var("MPROG_BENCH_ONLY").unwrap_or_default();
     for path in files {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        if !name.contains(&only) {
+            continue;
+        }
         let prog = program(&std::fs::read_to_string(&path).unwrap());
         let m = motion(prog.people().len(), 196);
         let (one, [_, people, frames, j, c]) = flat(&m);
@@ -48,7 +56,11 @@ fn bench_programs() {
         for batch in [1usize, 32] {
             let data: Vec<f32> = (0..batch).flat_map(|_| one.iter().copied()).collect();
             let shape = [batch, people, frames, j, c];
-            let runs = if batch == 1 { 50 } else { 10 };
+            let repeat: usize = std::env::var("MPROG_BENCH_REPEAT")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(1);
+            let runs = repeat * if batch == 1 { 50 } else { 10 };
             let plain = Device::flex();
             let x = Tensor::<5>::from_data(TensorData::new(data.clone(), shape), &plain);
             let eval_us = time(runs, || {

@@ -291,7 +291,6 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
     meta.insert("blend".into(), args.blend.into());
     let resample = resample_rounds(args, if keep.is_empty() { 0 } else { DEFAULT_RESAMPLE })?;
     meta.insert("resample".into(), resample.into());
-    meta.insert("foot_cleanup".into(), true.into());
     Ok(Some(TakePlan {
         people,
         after: None,
@@ -380,7 +379,6 @@ fn plan_between(
     meta.insert("blend".into(), args.blend.into());
     let resample = resample_rounds(args, DEFAULT_RESAMPLE)?;
     meta.insert("resample".into(), resample.into());
-    meta.insert("foot_cleanup".into(), true.into());
     Ok(TakePlan {
         people: before,
         after: Some(after_part),
@@ -452,6 +450,9 @@ impl TakePlan {
                 format!("held to the take: {}", parts.join(", "))
             }
         );
+        // The cleanup skips edits that hold both legs (see `Edit::clean_feet`).
+        let legs_held = ["left leg", "right leg"].iter().all(|l| parts.contains(l));
+        self.meta.insert("foot_cleanup".into(), (!legs_held).into());
         self.meta.insert("keep_path".into(), hold_path.into());
         self.meta
             .insert("held_parts".into(), serde_json::json!(parts));

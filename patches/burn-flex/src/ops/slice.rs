@@ -181,6 +181,27 @@ fn slice_write_impl<E: Element + bytemuck::Pod>(
             source.write_span(dst, dst_row_start, col_len, val_offset);
             val_offset += col_len;
         }
+    } else if inner_contiguous
+        && (0..ndims - 1).all(|d| {
+            let (start, len, step) = slice_info[d];
+            start == 0 && step == 1 && len == dst_layout.shape()[d]
+        })
+    {
+        // mprog patch: every outer dim whole (the backward of `x[..., k]`, one coordinate
+        // of `[B, P, N, J, 3]` joints): the region is rows of the last dim, written
+        // without the per-row odometer below, one element at a time when rows are 1 long.
+        let (col_start, inner_len, _) = slice_info[ndims - 1];
+        let cols = dst_layout.shape()[ndims - 1];
+        let rows: usize = dst_layout.shape()[..ndims - 1].iter().product();
+        if inner_len == 1 {
+            for r in 0..rows {
+                source.write_element(dst, r * cols + col_start, r);
+            }
+        } else {
+            for r in 0..rows {
+                source.write_span(dst, r * cols + col_start, inner_len, r * inner_len);
+            }
+        }
     } else if inner_contiguous {
         let inner_len = slice_info[ndims - 1].1;
         let outer_dims = ndims - 1;
