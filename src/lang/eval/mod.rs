@@ -15,7 +15,7 @@ pub use frames::{FrameErrors, evaluate_frames};
 use crate::lang::ir::*;
 use crate::skeleton::NUM_JOINTS;
 use burn::tensor::{Int, Tensor, TensorData};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::sync::Mutex;
 
 /// Errors of one evaluation.
@@ -75,6 +75,10 @@ struct CachedIndices {
     frames: usize,
     device: burn::tensor::Device,
     gathers: HashMap<NodeId, Tensor<1, Int>>,
+    /// Gathers that read every row in order (every joint of every person on every
+    /// frame, as `for j in joints` over `always` does): the rows themselves, with no
+    /// copy forward and no scatter into zeros backward.
+    whole: HashSet<NodeId>,
     consts: HashMap<NodeId, Tensor<4>>,
     domain_sizes: Vec<usize>,
 }
@@ -91,6 +95,15 @@ impl std::fmt::Debug for IndexCache {
     }
 }
 
+/// The rows gather `node` reads: `rows` itself when it reads every row in order.
+fn gather_rows(rows: &Tensor<3>, idx: &CachedIndices, node: NodeId) -> Tensor<3> {
+    if idx.whole.contains(&node) {
+        rows.clone()
+    } else {
+        rows.clone().select(1, idx.gathers[&node].clone())
+    }
+}
+
 /// Flat row index of (person, frame, joint) in the `[batch, people·frames·22, 3]` view.
 fn flat(person: usize, frame: usize, joint: usize, frames: usize) -> i64 {
     ((person * frames + frame) * NUM_JOINTS + joint) as i64
@@ -101,7 +114,9 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
         .map(|d| ir.resolve_domain(d, frames).len())
         .collect();
     let mut gathers = HashMap::new();
+    let mut whole = HashSet::new();
     let mut consts = HashMap::new();
+    let rows = ir.people * frames * NUM_JOINTS;
     for (i, node) in ir.nodes.iter().enumerate() {
         if let Op::Const(v) = &node.op {
             let c = v.len();
@@ -132,6 +147,9 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
             .flat_map(|&t| points.iter().map(move |&(p, j)| flat(p, t, j, frames)))
             .collect();
         let n = idx.len();
+        if n == rows && idx.iter().enumerate().all(|(k, &r)| r == k as i64) {
+            whole.insert(i);
+        }
         gathers.insert(
             i,
             Tensor::<1, Int>::from_data(TensorData::new(idx, [n]), device),
@@ -141,6 +159,7 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
         frames,
         device: device.clone(),
         gathers,
+        whole,
         consts,
         domain_sizes,
     }
@@ -208,11 +227,11 @@ fn with_node_values<T>(
             Op::Const(_) => idx.consts[&i].clone(),
             Op::Gather { .. } => {
                 // [batch, |D|·K, 3] → [batch, |D|, K, 3]
-                let g = rows.clone().select(1, idx.gathers[&i].clone());
+                let g = gather_rows(&rows, idx, i);
                 g.reshape([batch, frames_of(node), node.lanes, 3])
             }
             Op::MassCenter { weights, .. } => {
-                let g = rows.clone().select(1, idx.gathers[&i].clone());
+                let g = gather_rows(&rows, idx, i);
                 // [batch, |D|, K, 22, 3] weighted over joints → [batch, |D|, K, 3]
                 let g: Tensor<5> = g.reshape([batch, frames_of(node), node.lanes, NUM_JOINTS, 3]);
                 let w =
@@ -327,5 +346,47 @@ fn statement_error(
         col
     } else {
         col.expand([batch, 1])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::lang::compile;
+    use crate::skeleton::{JOINT_NAMES, NUM_JOINTS};
+    use burn::prelude::*;
+
+    /// Error and gradient of `for j in LIST { j.x < 0.1 m  j.z > -0.1 m }` on a seeded motion.
+    fn error_and_grad(list: &str) -> (Vec<f32>, Vec<f32>) {
+        let src = format!(
+            "length 9 frames\nfor j in {list} {{ always {{ j.x < 0.1 m\n j.z > -0.1 m }} }}\n"
+        );
+        let program = compile(&src, "all_joints.mprog", &[]).expect("compiles");
+        let dims = [2, 1, 9, NUM_JOINTS, 3];
+        let n: usize = dims.iter().product();
+        let v: Vec<f32> = (0..n)
+            .map(|k| ((k * 7919) % 113) as f32 / 113.0 - 0.5)
+            .collect();
+        let ad = Device::flex().autodiff();
+        let x = Tensor::<5>::from_data(TensorData::new(v, dims), &ad).require_grad();
+        let e = program.evaluate(x.clone()).total;
+        let g = x.grad(&e.clone().sum().backward()).expect("a gradient");
+        let host = |t: Tensor<1>| t.into_data().try_to_vec::<f32>().unwrap();
+        (host(e), host(g.reshape([n])))
+    }
+
+    #[test]
+    fn a_gather_of_every_joint_in_order_reads_the_motion_itself() {
+        // `joints` gathers every row in order (no copy); the same joints listed in reverse
+        // are a real gather. The error and its gradient must agree.
+        let whole = error_and_grad("joints");
+        let reversed: Vec<&str> = JOINT_NAMES.iter().rev().copied().collect();
+        let listed = error_and_grad(&format!("[{}]", reversed.join(", ")));
+        for (a, b) in whole.0.iter().zip(&listed.0) {
+            assert!((a - b).abs() <= 1e-6 * (1.0 + b.abs()), "{a} vs {b}");
+        }
+        assert!(whole.0.iter().any(|e| *e > 0.0));
+        for (a, b) in whole.1.iter().zip(&listed.1) {
+            assert!((a - b).abs() <= 1e-6, "{a} vs {b}");
+        }
     }
 }
