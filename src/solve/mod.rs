@@ -99,7 +99,7 @@ mod tests;
 pub use crate::scene::{DEFAULT_SPACING, Placement};
 pub use decode::{Decoder, RigidTensors};
 pub use edit::{DEFAULT_BLEND, DEFAULT_STRENGTH, Edit, hold_weights, in_between_hold};
-pub use guide::{GuideConfig, StepRule, VarianceRule};
+pub use guide::{FusedSettings, GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;
 pub use knobs::{KnobKind, KnobValue};
 pub use latent::{LatentConfig, Relax};
