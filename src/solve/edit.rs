@@ -24,8 +24,8 @@
 //! and [`Ctx::hold_final`]; with no take they change nothing.
 
 use super::SolveError;
+use super::driver::Ctx;
 use super::request::{Phase, Progress};
-use super::run::Ctx;
 use super::take::Take;
 use crate::features::FEATURE_DIM;
 use crate::model::sampler::{SamplerKind, ddim_step, guided_x0, posterior_mean, schedule_for};

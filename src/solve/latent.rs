@@ -44,7 +44,7 @@ use super::host::{extract_head, insert_head};
 use crate::scene::Placement;
 use super::reference::ReferencePull;
 use super::request::{Phase, Progress};
-use super::run::{Ctx, Outcome, ensure_finite, host, mean};
+use super::driver::{Ctx, Outcome, ensure_finite, host, mean};
 use super::{SolveError, host::check_shape};
 use crate::features::FEATURE_DIM;
 use crate::model::sampler::{Condition, ddim_step, guided_x0};

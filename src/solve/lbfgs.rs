@@ -41,7 +41,7 @@ use super::SolveError;
 use super::guide::smooth_over_frames;
 use super::host::{HEAD, check_shape, extract_head, insert_head};
 use super::request::{Phase, Progress};
-use super::run::{Ctx, Outcome, ensure_finite, host, mean};
+use super::driver::{Ctx, Outcome, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
 use super::realism::Realism;
 use crate::model::sampler::posterior_mean;

@@ -53,6 +53,7 @@ pub mod adam;
 pub mod bones;
 pub mod cleanup;
 mod decode;
+mod driver;
 pub mod edit;
 pub mod feet;
 pub mod host;
@@ -60,7 +61,6 @@ pub mod knobs;
 mod realism;
 pub mod reference;
 mod request;
-mod run;
 mod solver;
 pub mod take;
 
@@ -98,6 +98,7 @@ mod tests;
 
 pub use crate::scene::{DEFAULT_SPACING, Placement};
 pub use decode::{Decoder, RigidTensors};
+pub use driver::{Ctx, Outcome, solve};
 pub use edit::{DEFAULT_BLEND, DEFAULT_STRENGTH, Edit, hold_weights, in_between_hold};
 pub use guide::{FusedSettings, GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;
@@ -106,7 +107,6 @@ pub use latent::{LatentConfig, Relax};
 pub use lbfgs::LbfgsConfig;
 pub use plain::PlainConfig;
 pub use request::{Phase, Prior, Progress, SolveRequest, SolveResult};
-pub use run::{Ctx, Outcome, solve};
 pub use solver::{Solver, SolverConfig, SolverSpec, solvers_help};
 pub use take::Take;
 
