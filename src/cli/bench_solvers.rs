@@ -25,7 +25,7 @@ pub struct SolverBenchArgs {
     /// default 100 measures seconds per iteration and extrapolates the total, saying so.
     #[arg(long, default_value_t = 100)]
     latent_iterations: usize,
-    /// Leave out the burn-tape inner loop (`guide` with fused=0), the slowest row.
+    /// Leave out the burn-tape inner loop (`guide` with `fused: None`), the slowest row.
     #[arg(long)]
     skip_tape: bool,
     /// Seed of every run.
@@ -154,11 +154,7 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
     } else {
         Some(run(
             Solver::new(GuideConfig {
-                fused: false,
-                keep_skeleton: false,
-                foot_lock: 0.0,
-                early_root_only: false,
-                split_terms: false,
+                fused: None,
                 ..guide.clone()
             }),
             "guide (burn autodiff tape, skeleton=0)",

@@ -7,7 +7,7 @@
 //!   across = (r_hip − l_hip) + (r_sh − l_sh) (the correct rule, not the per-frame quirk).
 
 use super::FeatureError;
-use super::ik::{self, Pose64, motion_from_f64, poses_f64};
+use super::kinematics::{self, Pose64, motion_from_f64, poses_f64};
 use crate::motion::Motion;
 use glam::DVec3;
 
@@ -31,7 +31,7 @@ pub(crate) fn canonicalize_f64(mut poses: Vec<Pose64>) -> Result<Vec<Pose64>, Fe
         .map(|p| p.y)
         .fold(f64::INFINITY, f64::min);
     let shift = DVec3::new(first[0].x, floor, first[0].z);
-    let turn = ik::body_facing(first, 0)?.inverse();
+    let turn = kinematics::body_facing(first, 0)?.inverse();
     for pose in &mut poses {
         for p in pose.iter_mut() {
             *p = turn * (*p - shift);

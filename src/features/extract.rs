@@ -3,7 +3,7 @@
 //!
 //! Steps: optional retarget to the uniform skeleton ([`super::uniform_skeleton`]),
 //! [`super::canonicalize`], foot contacts, the smoothed per-frame root rotation `r[t]`
-//! ([`ik::root_rotations`], quirk included), IK for the 6-D block, then per frame t < F − 1:
+//! ([`kinematics::root_rotations`], quirk included), IK for the 6-D block, then per frame t < F − 1:
 //! * yaw velocity = arcsin of the y component of `r[t+1]·r[t]⁻¹` (a half-angle);
 //! * root velocity = `r[t+1]·(p₀[t+1] − p₀[t])`, x and z;
 //! * root height = `p₀[t].y`;
@@ -14,7 +14,7 @@
 
 use super::FeatureError;
 use super::canonical::canonicalize_f64;
-use super::ik::{self, Pose64};
+use super::kinematics::{self, Pose64};
 use super::layout::{FEATURE_DIM, Features};
 use super::retarget::uniform_skeleton_f64;
 use crate::motion::Motion;
@@ -47,13 +47,13 @@ pub fn extract(m: &Motion, opts: &ExtractOptions) -> Result<Features, FeatureErr
     if (m.fps - FPS).abs() > 1e-3 {
         return Err(FeatureError::WrongFps { fps: m.fps });
     }
-    let mut poses = ik::poses_f64(m)?;
+    let mut poses = kinematics::poses_f64(m)?;
     if opts.uniform_skeleton {
         poses = uniform_skeleton_f64(&poses)?;
     }
     let poses = canonicalize_f64(poses)?;
-    let roots = ik::root_rotations(&poses, true)?;
-    let locals = ik::inverse_kinematics(&poses, &roots)?;
+    let roots = kinematics::root_rotations(&poses, true)?;
+    let locals = kinematics::inverse_kinematics(&poses, &roots)?;
     let mut data = Vec::with_capacity((poses.len() - 1) * FEATURE_DIM);
     for t in 0..poses.len() - 1 {
         let frame = Frame {
@@ -107,7 +107,7 @@ impl Frame<'_> {
             push3(out, self.r * (*p - ground));
         }
         for q in &locals[1..] {
-            out.extend(ik::rotation_6d(*q).map(|x| x as f32));
+            out.extend(kinematics::rotation_6d(*q).map(|x| x as f32));
         }
         for (p, n) in self.now.iter().zip(self.next) {
             push3(out, self.r * (*n - *p));

@@ -9,7 +9,7 @@
 //! | --- | --- | --- |
 //! | retarget (optional) | [`uniform_skeleton`] | every bone set to HumanML3D's length, root scaled by leg length |
 //! | canonicalise | [`canonicalize`] | floor at y = 0, frame-0 root XZ at the origin, frame 0 faces +Z |
-//! | rotations | [`ik`] | per-bone rotations from positions, HumanML3D's local rotations, facing |
+//! | rotations | [`kinematics`] | per-bone rotations from positions, HumanML3D's local rotations, facing |
 //! | features | [`extract`] | the seven blocks of [`layout`] |
 //! | back to joints | [`recover_from_ric`], [`recover_from_ric_tensor`] | integrate the root, un-rotate the ric block |
 //!
@@ -20,7 +20,7 @@
 mod canonical;
 mod error;
 mod extract;
-pub mod ik;
+pub mod kinematics;
 pub mod layout;
 mod mirror;
 mod norm;

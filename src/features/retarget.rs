@@ -4,13 +4,15 @@
 //!
 //! As HumanML3D does it: the root track is scaled by the ratio of leg lengths
 //! (hip→knee + knee→ankle of the right leg, target over source, the source measured on
-//! frame 0); joint rotations come from IK ([`super::ik`]); FK with the target offsets
+//! frame 0); joint rotations come from IK ([`super::kinematics`]); FK with the target offsets
 //! (raw direction × target length) rebuilds the joints. Because HumanML3D's IK gives every
 //! bone its minimal-arc global rotation, the result keeps every bone's direction and sets its
 //! length to the target length; the root rotation cancels out, so none is needed here.
 
 use super::FeatureError;
-use super::ik::{Pose64, forward_kinematics, inverse_kinematics, motion_from_f64, poses_f64};
+use super::kinematics::{
+    Pose64, forward_kinematics, inverse_kinematics, motion_from_f64, poses_f64,
+};
 use crate::motion::Motion;
 use crate::skeleton::{BONE_LENGTHS, NUM_JOINTS, PARENTS, RAW_OFFSETS};
 use glam::{DQuat, DVec3};

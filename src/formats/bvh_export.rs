@@ -17,7 +17,7 @@
 
 use super::rig::{self, Node};
 use crate::features::FeatureError;
-use crate::features::ik::{self, Pose64};
+use crate::features::kinematics::{self, Pose64};
 use crate::fsutil::write_atomic;
 use crate::motion::Motion;
 use crate::skeleton::NUM_JOINTS;
@@ -105,7 +105,7 @@ pub fn bvh_string(m: &Motion, opts: &BvhExportOptions) -> Result<String, BvhExpo
         }
         _ => m,
     };
-    let poses = ik::poses_f64(m)?;
+    let poses = kinematics::poses_f64(m)?;
     let writer = Writer {
         nodes: rig::hierarchy(),
         lengths: rig::mean_bone_lengths(&poses),

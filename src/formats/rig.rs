@@ -5,9 +5,9 @@
 //! offsets, and each node's local rotation per frame, whose forward kinematics gives back
 //! the positions (up to the bone lengths, which the rig takes as their mean over frames).
 //!
-//! * Rotations come from [`ik::chained_bone_rotations`]: every bone gets its parent bone's
+//! * Rotations come from [`kinematics::chained_bone_rotations`]: every bone gets its parent bone's
 //!   rotation plus the minimal swing to its current direction; the bones leaving the pelvis
-//!   are oriented by the body's facing ([`ik::body_facing`]).
+//!   are oriented by the body's facing ([`kinematics::body_facing`]).
 //! * A node has one rotation for all its children, while pelvis and spine3 have several
 //!   bones leaving them whose relative angles change over time; so each of those bones
 //!   hangs from a zero-offset connector node (`pelvis_to_left_hip`, …,
@@ -15,7 +15,7 @@
 //!   facing yaw; spine3 carries the neck bone.
 
 use crate::features::FeatureError;
-use crate::features::ik::{self, Pose64};
+use crate::features::kinematics::{self, Pose64};
 use crate::skeleton::{JOINT_NAMES, NUM_JOINTS, PARENTS, RAW_OFFSETS};
 use glam::{DQuat, DVec3};
 
@@ -127,8 +127,8 @@ pub fn local_rotations(
     frame: usize,
     axes: DQuat,
 ) -> Result<Vec<DQuat>, FeatureError> {
-    let facing = ik::body_facing(pose, frame)?;
-    let bones = ik::chained_bone_rotations(pose, frame, facing)?;
+    let facing = kinematics::body_facing(pose, frame)?;
+    let bones = kinematics::chained_bone_rotations(pose, frame, facing)?;
     let to_file = |q: DQuat| axes * q * axes.inverse();
     let mut global = vec![DQuat::IDENTITY; nodes.len()];
     let mut local = Vec::with_capacity(nodes.len());

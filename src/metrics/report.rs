@@ -333,72 +333,255 @@ pub fn run_eval(
             "model and evaluator must both read {FEATURE_DIM} features"
         )));
     }
-    let cap = bundle
-        .config
-        .max_frames
-        .min(evaluator.manifest.config.max_frames);
-    let eligible: Vec<&ClipInfo> = data
-        .clips(Split::Test)
-        .filter(|c| c.frames >= settings.min_frames.max(2) && !c.captions.is_empty())
-        .collect();
-    let count = settings.count.min(eligible.len());
-    if count < 2 {
-        return Err(MetricsError::Invalid(format!(
-            "the test split has {} clips of at least {} frames; at least 2 are needed",
-            eligible.len(),
-            settings.min_frames
-        )));
-    }
-    let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
-    let mut shuffled = eligible.clone();
-    shuffled.shuffle(&mut rng);
-    let prompts: Vec<Prompt> = shuffled[..count]
-        .iter()
-        .map(|&clip| Prompt {
-            clip,
-            caption: pick_caption(clip, &mut rng),
-            frames: clip.frames.min(cap),
-        })
-        .collect();
-    let sources: HashSet<&str> = prompts.iter().map(|p| p.clip.source.as_str()).collect();
-    let reference_clips: Vec<&ClipInfo> = eligible
-        .iter()
-        .copied()
-        .filter(|c| !sources.contains(c.source.as_str()))
-        .collect();
-    if reference_clips.len() < 2 {
-        return Err(MetricsError::Invalid(format!(
-            "only {} test clips are left for the FID reference; lower --count",
-            reference_clips.len()
-        )));
-    }
-    log(&format!(
-        "{count} prompts, FID reference of {} held-out test clips",
-        reference_clips.len()
-    ));
-    let ref_rows: Vec<&[f32]> = reference_clips
-        .iter()
-        .map(|c| &data.clip_features(c)[..c.frames.min(cap) * FEATURE_DIM])
-        .collect();
-    let distractor_captions: Vec<String> =
-        eligible.iter().map(|c| pick_caption(c, &mut rng)).collect();
-    let captions: Vec<&str> = distractor_captions.iter().map(String::as_str).collect();
-    let reference = Reference {
-        embeddings: evaluator.embed_motions(&ref_rows, device)?,
-        distractors: evaluator
-            .embed_captions(&captions, device)?
-            .into_iter()
-            .zip(&eligible)
-            .map(|(embedding, c)| Distractor {
-                embedding,
-                group: c.content.clone(),
-            })
-            .collect(),
+    let eval = Evaluation {
+        data,
+        bundle,
+        evaluator,
+        settings,
+        device,
+        cap: bundle
+            .config
+            .max_frames
+            .min(evaluator.manifest.config.max_frames),
     };
+    // One generator, drawn from in this order: clips, captions, distractors, per label.
+    let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
+    let chosen = eval.choose_clips(&mut rng)?;
+    log(&format!(
+        "{} prompts, FID reference of {} held-out test clips",
+        chosen.prompts.len(),
+        chosen.reference.len()
+    ));
+    let reference = eval.reference(&chosen, &mut rng)?;
+    let (real, frozen) = real_and_frozen(data, &chosen.prompts)?;
+    let clock = std::time::Instant::now();
+    let generated = generate_for(
+        bundle,
+        &chosen.prompts,
+        settings,
+        settings.seed,
+        device,
+        log,
+    )?;
+    let mut generate_seconds = clock.elapsed().as_secs_f64();
+    let mut samples = samples_of(&generated);
+    let rows = eval.score_rows([&real, &generated, &frozen], &reference)?;
+    let mut labels = Vec::new();
+    if let Some(k) = settings.per_label.filter(|&k| k > 0) {
+        for (li, label) in PER_LABELS.iter().enumerate() {
+            let (row, seconds) = eval.label_row(li, label, k, &mut rng, log, &mut samples)?;
+            generate_seconds += seconds;
+            labels.push(row);
+        }
+    }
+    let report = EvalReport {
+        rows,
+        labels,
+        model: (bundle.manifest.weights_id.clone(), bundle.manifest.steps),
+        evaluator: (evaluator.manifest.steps, evaluator.manifest.val_r_precision),
+        reference_clips: chosen.reference.len(),
+        settings: settings.clone(),
+        generate_seconds,
+    };
+    Ok((report, samples))
+}
 
+/// What every step of an evaluation reads.
+struct Evaluation<'a> {
+    data: &'a Dataset,
+    bundle: &'a ModelBundle,
+    evaluator: &'a Evaluator,
+    settings: &'a EvalSettings,
+    device: &'a Device,
+    /// The longest motion both the model and the evaluator take.
+    cap: usize,
+}
+
+/// The test clips an evaluation uses.
+struct ChosenClips<'a> {
+    /// Clips long enough and captioned.
+    eligible: Vec<&'a ClipInfo>,
+    /// The prompts, drawn from `eligible`.
+    prompts: Vec<Prompt<'a>>,
+    /// The FID reference: eligible clips from other source files than the prompts'.
+    reference: Vec<&'a ClipInfo>,
+}
+
+impl<'a> Evaluation<'a> {
+    /// Draws the prompts and sets the FID reference apart.
+    fn choose_clips(&self, rng: &mut ChaCha8Rng) -> Result<ChosenClips<'a>, MetricsError> {
+        let settings = self.settings;
+        let eligible: Vec<&ClipInfo> = self
+            .data
+            .clips(Split::Test)
+            .filter(|c| c.frames >= settings.min_frames.max(2) && !c.captions.is_empty())
+            .collect();
+        let count = settings.count.min(eligible.len());
+        if count < 2 {
+            return Err(MetricsError::Invalid(format!(
+                "the test split has {} clips of at least {} frames; at least 2 are needed",
+                eligible.len(),
+                settings.min_frames
+            )));
+        }
+        let mut shuffled = eligible.clone();
+        shuffled.shuffle(rng);
+        let prompts: Vec<Prompt> = shuffled[..count]
+            .iter()
+            .map(|&clip| Prompt {
+                clip,
+                caption: pick_caption(clip, rng),
+                frames: clip.frames.min(self.cap),
+            })
+            .collect();
+        let sources: HashSet<&str> = prompts.iter().map(|p| p.clip.source.as_str()).collect();
+        let reference: Vec<&ClipInfo> = eligible
+            .iter()
+            .copied()
+            .filter(|c| !sources.contains(c.source.as_str()))
+            .collect();
+        if reference.len() < 2 {
+            return Err(MetricsError::Invalid(format!(
+                "only {} test clips are left for the FID reference; lower --count",
+                reference.len()
+            )));
+        }
+        Ok(ChosenClips {
+            eligible,
+            prompts,
+            reference,
+        })
+    }
+
+    /// The reference clips' embeddings, and a caption of every eligible clip as an
+    /// R-precision distractor.
+    fn reference(
+        &self,
+        chosen: &ChosenClips,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Reference, MetricsError> {
+        let (evaluator, device) = (self.evaluator, self.device);
+        let ref_rows: Vec<&[f32]> = chosen
+            .reference
+            .iter()
+            .map(|c| &self.data.clip_features(c)[..c.frames.min(self.cap) * FEATURE_DIM])
+            .collect();
+        let distractor_captions: Vec<String> = chosen
+            .eligible
+            .iter()
+            .map(|c| pick_caption(c, rng))
+            .collect();
+        let captions: Vec<&str> = distractor_captions.iter().map(String::as_str).collect();
+        Ok(Reference {
+            embeddings: evaluator.embed_motions(&ref_rows, device)?,
+            distractors: evaluator
+                .embed_captions(&captions, device)?
+                .into_iter()
+                .zip(&chosen.eligible)
+                .map(|(embedding, c)| Distractor {
+                    embedding,
+                    group: c.content.clone(),
+                })
+                .collect(),
+        })
+    }
+
+    /// The table's rows: real test data, the model, the trivial baseline.
+    fn score_rows(
+        &self,
+        [real, generated, frozen]: [&MotionSet; 3],
+        reference: &Reference,
+    ) -> Result<Vec<SetScores>, MetricsError> {
+        let (evaluator, seed, device) = (self.evaluator, self.settings.seed, self.device);
+        let model_name = format!(
+            "model ({}, {} steps)",
+            self.bundle.manifest.weights_id, self.bundle.manifest.steps
+        );
+        Ok(vec![
+            score_set("real test data", real, reference, evaluator, seed, device)?,
+            score_set(&model_name, generated, reference, evaluator, seed, device)?,
+            score_set(
+                "trivial baseline (first pose held)",
+                frozen,
+                reference,
+                evaluator,
+                seed,
+                device,
+            )?,
+        ])
+    }
+
+    /// The per-label row of `label` (the `li`-th): its real test clips against `k`
+    /// motions generated from their captions, which join `samples`; also returns the
+    /// seconds spent generating.
+    fn label_row(
+        &self,
+        li: usize,
+        label: &str,
+        k: usize,
+        rng: &mut ChaCha8Rng,
+        log: &mut dyn FnMut(&str),
+        samples: &mut Vec<Sample>,
+    ) -> Result<(LabelRow, f64), MetricsError> {
+        let (data, cap) = (self.data, self.cap);
+        let clips: Vec<&ClipInfo> = data
+            .clips(Split::Test)
+            .filter(|c| c.content == *label && c.frames >= 2 && !c.captions.is_empty())
+            .collect();
+        let real_motions: Vec<Motion> = clips
+            .iter()
+            .map(|c| real_motion(data, c, c.frames.min(cap)).0)
+            .collect();
+        let mut seconds = 0.0;
+        let generated = if clips.is_empty() {
+            None
+        } else {
+            let chosen: Vec<Prompt> = (0..k)
+                .map(|_| {
+                    let clip = clips[rng.random_range(0..clips.len())];
+                    Prompt {
+                        clip,
+                        caption: pick_caption(clip, rng),
+                        frames: clip.frames.min(cap).max(2),
+                    }
+                })
+                .collect();
+            log(&format!("per-label: {label}"));
+            let label_seed = self.settings.seed.wrapping_add(1000 * (li as u64 + 1));
+            let clock = std::time::Instant::now();
+            let set = generate_for(
+                self.bundle,
+                &chosen,
+                self.settings,
+                label_seed,
+                self.device,
+                log,
+            )?;
+            seconds = clock.elapsed().as_secs_f64();
+            samples.extend(set.motions.iter().zip(&set.captions).map(|(m, c)| Sample {
+                caption: c.clone(),
+                label: label.to_string(),
+                motion: m.clone(),
+            }));
+            Some(label_stats(&set.motions))
+        };
+        let row = LabelRow {
+            label: label.to_string(),
+            real: label_stats(&real_motions),
+            generated,
+        };
+        Ok((row, seconds))
+    }
+}
+
+/// The prompts' real clips and the trivial baseline's frozen first poses.
+fn real_and_frozen(
+    data: &Dataset,
+    prompts: &[Prompt],
+) -> Result<(MotionSet, MotionSet), MetricsError> {
     let mut real = MotionSet::default();
     let mut frozen = MotionSet::default();
-    for p in &prompts {
+    for p in prompts {
         for (set, (motion, features)) in [
             (&mut real, real_motion(data, p.clip, p.frames)),
             (&mut frozen, frozen_motion(data, p.clip, p.frames)?),
@@ -409,88 +592,19 @@ pub fn run_eval(
             set.labels.push(p.clip.content.clone());
         }
     }
-    let mut clock = std::time::Instant::now();
-    let generated = generate_for(bundle, &prompts, settings, settings.seed, device, log)?;
-    let mut generate_seconds = clock.elapsed().as_secs_f64();
-    let mut samples: Vec<Sample> = generated
-        .motions
+    Ok((real, frozen))
+}
+
+/// The motions of a generated set, with their captions and labels, for pictures.
+fn samples_of(set: &MotionSet) -> Vec<Sample> {
+    set.motions
         .iter()
-        .zip(&generated.captions)
-        .zip(&generated.labels)
+        .zip(&set.captions)
+        .zip(&set.labels)
         .map(|((m, c), l)| Sample {
             caption: c.clone(),
             label: l.clone(),
             motion: m.clone(),
         })
-        .collect();
-    let model_name = format!(
-        "model ({}, {} steps)",
-        bundle.manifest.weights_id, bundle.manifest.steps
-    );
-    let seed = settings.seed;
-    let rows = vec![
-        score_set("real test data", &real, &reference, evaluator, seed, device)?,
-        score_set(&model_name, &generated, &reference, evaluator, seed, device)?,
-        score_set(
-            "trivial baseline (first pose held)",
-            &frozen,
-            &reference,
-            evaluator,
-            seed,
-            device,
-        )?,
-    ];
-    let mut labels = Vec::new();
-    if let Some(k) = settings.per_label.filter(|&k| k > 0) {
-        for (li, label) in PER_LABELS.iter().enumerate() {
-            let clips: Vec<&ClipInfo> = data
-                .clips(Split::Test)
-                .filter(|c| c.content == *label && c.frames >= 2 && !c.captions.is_empty())
-                .collect();
-            let real_motions: Vec<Motion> = clips
-                .iter()
-                .map(|c| real_motion(data, c, c.frames.min(cap)).0)
-                .collect();
-            let generated = if clips.is_empty() {
-                None
-            } else {
-                let chosen: Vec<Prompt> = (0..k)
-                    .map(|_| {
-                        let clip = clips[rng.random_range(0..clips.len())];
-                        Prompt {
-                            clip,
-                            caption: pick_caption(clip, &mut rng),
-                            frames: clip.frames.min(cap).max(2),
-                        }
-                    })
-                    .collect();
-                log(&format!("per-label: {label}"));
-                let label_seed = seed.wrapping_add(1000 * (li as u64 + 1));
-                clock = std::time::Instant::now();
-                let set = generate_for(bundle, &chosen, settings, label_seed, device, log)?;
-                generate_seconds += clock.elapsed().as_secs_f64();
-                samples.extend(set.motions.iter().zip(&set.captions).map(|(m, c)| Sample {
-                    caption: c.clone(),
-                    label: label.to_string(),
-                    motion: m.clone(),
-                }));
-                Some(label_stats(&set.motions))
-            };
-            labels.push(LabelRow {
-                label: label.to_string(),
-                real: label_stats(&real_motions),
-                generated,
-            });
-        }
-    }
-    let report = EvalReport {
-        rows,
-        labels,
-        model: (bundle.manifest.weights_id.clone(), bundle.manifest.steps),
-        evaluator: (evaluator.manifest.steps, evaluator.manifest.val_r_precision),
-        reference_clips: reference_clips.len(),
-        settings: settings.clone(),
-        generate_seconds,
-    };
-    Ok((report, samples))
+        .collect()
 }

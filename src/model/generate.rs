@@ -2,7 +2,7 @@
 //! de-normalised features → joints. Batched over `count` samples.
 
 use super::denoiser::Denoiser;
-use super::mirror::MirrorAveraged;
+use super::mirror_average::MirrorAveraged;
 use super::noise::NoiseSource;
 use super::sampler::{Condition, SamplerKind, sample_chain_until, schedule_for};
 use super::schedule::{DIFFUSION_STEPS, NoiseSchedule};

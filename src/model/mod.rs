@@ -9,7 +9,7 @@ pub mod control;
 pub mod denoiser;
 pub mod ema;
 pub mod generate;
-pub mod mirror;
+pub mod mirror_average;
 pub mod noise;
 pub mod prompt;
 pub mod sampler;

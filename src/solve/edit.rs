@@ -25,8 +25,8 @@
 
 use super::SolveError;
 use super::cleanup::{FootCleanup, clean_feet};
+use super::driver::{Ctx, host};
 use super::request::{Phase, Progress};
-use super::run::{Ctx, host};
 use super::take::Take;
 use crate::features::FEATURE_DIM;
 use crate::features::layout::{CONTACT, LOCAL_VEL, RIC, ROOT_Y, ROT};

@@ -12,12 +12,12 @@
 //! mprog's additions, each on by default and turned back by its knob (why each was made,
 //! with the renders and numbers behind it: the book's "Six places where `guide` departs
 //! from OmniControl"):
-//! * early steps move only the root columns ([`GuideConfig::early_root_only`], `early_root`);
-//! * the last T_s steps keep bone lengths and planted feet ([`GuideConfig::keep_skeleton`],
-//!   [`super::bones`]), hold planted toes ([`GuideConfig::foot_lock`], [`super::feet`]),
+//! * early steps move only the root columns ([`FusedSettings::early_root_only`], `early_root`);
+//! * the last T_s steps keep bone lengths and planted feet ([`FusedSettings::keep_skeleton`],
+//!   [`super::bones`]), hold planted toes ([`FusedSettings::foot_lock`], [`super::feet`]),
 //!   smooth the step over frames ([`GuideConfig::smooth_frames`]), give each statement its
-//!   own Polyak step ([`GuideConfig::split_terms`]) and scale the root columns down
-//!   ([`GuideConfig::late_root_scale`], `late_root`);
+//!   own Polyak step ([`FusedSettings::split_terms`]) and scale the root columns down
+//!   ([`FusedSettings::late_root_scale`], `late_root`);
 //! * frame 0 is not frozen ([`GuideConfig::freeze_first_frame`], `freeze`).
 //!
 //! The denoiser is not in the inner loop: only FK, the error and its gradient are, through
@@ -31,7 +31,7 @@ use crate::model::sampler::SamplerKind;
 use super::SolveError;
 use super::host::{HEAD, HostObjective, TermGradients, check_shape, extract_head, insert_head};
 use super::request::{Phase, Progress};
-use super::run::{Ctx, Outcome, ensure_finite, host, mean};
+use super::driver::{Ctx, Outcome, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
 use super::realism::Realism;
 use crate::model::sampler::posterior_mean;
@@ -87,26 +87,35 @@ pub struct GuideConfig {
     /// Zero the gradient of frame 0 (the reference code does; off by default, see the
     /// module notes).
     pub freeze_first_frame: bool,
-    /// Evaluate the inner loop through the fused host FK (fast); `false` runs it through the
-    /// burn graph (the reference, for tests and checks).
-    pub fused: bool,
-    /// In the last `late_steps` steps, optimise through the skeleton projection and write
-    /// it back ([`super::bones`]): bone lengths kept, planted feet kept on the floor. Needs
-    /// the fused path.
-    pub keep_skeleton: bool,
     /// σ in frames of the Gaussian the gradient is smoothed with over time before each
     /// step of the last `late_steps` steps (0: OmniControl's raw gradient).
     pub smooth_frames: f32,
+    /// `Some`: the inner loop runs through the fused host FK (fast), with mprog's additions
+    /// to OmniControl's update; `None`: through the burn graph (the reference, for tests and
+    /// checks), OmniControl's plain update.
+    pub fused: Option<FusedSettings>,
+    /// Steer every denoising step through the prior's ControlNet with a hint derived from
+    /// the program ([`super::realism`]); acts only when the bundle has a ControlNet.
+    pub realism: bool,
+}
+
+/// mprog's additions to OmniControl's inner loop. They exist only on the fused host path,
+/// so [`GuideConfig::fused`] holds them there and nowhere else.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FusedSettings {
+    /// In the last `late_steps` steps, optimise through the skeleton projection and write
+    /// it back ([`super::bones`]): bone lengths kept, planted feet kept on the floor.
+    pub keep_skeleton: bool,
     /// Weight of the slide penalty on planted feet in the last `late_steps` steps
-    /// ([`super::feet`]); 0 turns it off. Needs the fused path.
+    /// ([`super::feet`]); 0 turns it off.
     pub foot_lock: f32,
     /// Before the last `late_steps` steps, step only the root columns (yaw velocity, XZ
     /// velocity, height): the path is steered while the denoiser keeps the pose its own
-    /// (see the module notes). Needs the fused path.
+    /// (see the module notes).
     pub early_root_only: bool,
     /// In the last `late_steps` steps, size the Polyak step of each term of the error (each
     /// statement) on its own and step along the sum (see the module notes); `false` sizes
-    /// one step for the whole error. Needs the fused path.
+    /// one step for the whole error.
     pub split_terms: bool,
     /// In the last `late_steps` steps, the root columns' share of each step direction
     /// (a diagonal preconditioner, 0..=1; 1: the plain gradient). Moving the root moves
@@ -114,9 +123,43 @@ pub struct GuideConfig {
     /// does not make is met by walking the people into each other. Small values make the
     /// late steps meet it with the pose instead (see the module notes). Default 0.01.
     pub late_root_scale: f32,
-    /// Steer every denoising step through the prior's ControlNet with a hint derived from
-    /// the program ([`super::realism`]); acts only when the bundle has a ControlNet.
-    pub realism: bool,
+}
+
+impl FusedSettings {
+    /// None of the additions: OmniControl's plain update, which the graph path runs.
+    pub const PLAIN: FusedSettings = FusedSettings {
+        keep_skeleton: false,
+        foot_lock: 0.0,
+        early_root_only: false,
+        split_terms: false,
+        late_root_scale: 1.0,
+    };
+
+    fn check_settings(&self) -> Result<(), SolveError> {
+        if !(self.foot_lock.is_finite() && self.foot_lock >= 0.0) {
+            return Err(SolveError::Invalid(
+                "guide: the foot lock's weight must be finite and ≥ 0".into(),
+            ));
+        }
+        if !(self.late_root_scale.is_finite() && (0.0..=1.0).contains(&self.late_root_scale)) {
+            return Err(SolveError::Invalid(
+                "guide: late_root (the root columns' share of the late steps) must be between 0 and 1".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Default for FusedSettings {
+    fn default() -> Self {
+        FusedSettings {
+            keep_skeleton: true,
+            foot_lock: 1.0,
+            early_root_only: true,
+            split_terms: true,
+            late_root_scale: 0.01,
+        }
+    }
 }
 
 impl Default for GuideConfig {
@@ -131,13 +174,8 @@ impl Default for GuideConfig {
             variance_rule: VarianceRule::Floor,
             step_rule: StepRule::Polyak,
             freeze_first_frame: false,
-            fused: true,
-            keep_skeleton: true,
             smooth_frames: 4.0,
-            foot_lock: 1.0,
-            early_root_only: true,
-            split_terms: true,
-            late_root_scale: 0.01,
+            fused: Some(FusedSettings::default()),
             realism: true,
         }
     }
@@ -161,38 +199,10 @@ impl GuideConfig {
                 "guide: smooth_frames (σ of the gradient's smoothing over time) must be between 0 and 100 frames".into(),
             ));
         }
-        if !(self.foot_lock.is_finite() && self.foot_lock >= 0.0) {
-            return Err(SolveError::Invalid(
-                "guide: the foot lock's weight must be finite and ≥ 0".into(),
-            ));
+        match &self.fused {
+            Some(fused) => fused.check_settings(),
+            None => Ok(()),
         }
-        if self.foot_lock > 0.0 && !self.fused {
-            return Err(SolveError::Invalid(
-                "guide: the foot lock needs the fused inner loop (set fused or the foot lock to 0)"
-                    .into(),
-            ));
-        }
-        if self.early_root_only && !self.fused {
-            return Err(SolveError::Invalid(
-                "guide: early root-only steps need the fused inner loop (set fused or early_root to 0)".into(),
-            ));
-        }
-        if !(self.late_root_scale.is_finite() && (0.0..=1.0).contains(&self.late_root_scale)) {
-            return Err(SolveError::Invalid(
-                "guide: late_root (the root columns' share of the late steps) must be between 0 and 1".into(),
-            ));
-        }
-        if self.split_terms && !self.fused {
-            return Err(SolveError::Invalid(
-                "guide: per-term steps need the fused inner loop (set fused or split to 0)".into(),
-            ));
-        }
-        if self.keep_skeleton && !self.fused {
-            return Err(SolveError::Invalid(
-                "guide: keeping the skeleton needs the fused inner loop (set fused or turn keep_skeleton off)".into(),
-            ));
-        }
-        Ok(())
     }
 
     /// Inner iterations at step `i` of the chain (counted from 0 = the last, cleanest).
@@ -251,17 +261,12 @@ fn run(
         if k > 0 {
             let mut full = host(mu);
             let before = realism.is_on().then(|| full.clone());
-            let values = if cfg.fused {
-                let late = i < cfg.late_steps;
-                let inner = Inner {
-                    k,
-                    step,
-                    skeleton: cfg.keep_skeleton && late,
-                    foot_lock: if late { cfg.foot_lock } else { 0.0 },
-                };
-                guide_fused(ctx, cfg, &mut objective, &mut full, inner, i, &at)?
-            } else {
-                guide_graph(ctx, cfg, &mut full, k, step, i, &at)?
+            let values = match &cfg.fused {
+                Some(fused) => {
+                    let inner = Inner::at(cfg, fused, i, k, step);
+                    guide_fused(ctx, cfg, &mut objective, &mut full, inner, i, &at)?
+                }
+                None => guide_graph(ctx, cfg, &mut full, k, step, i, &at)?,
             };
             if let Some(before) = before {
                 realism.update(ctx, &before, &full)?;
@@ -290,14 +295,46 @@ fn run(
     })
 }
 
-/// One denoising step's inner loop: K iterations of this step size, through the skeleton
-/// projection or not, with or without the foot lock (weight 0: without).
+/// One denoising step's inner loop on the fused path: K iterations of this step size, and
+/// what the additions ([`FusedSettings`]) do at this step.
 #[derive(Clone, Copy)]
 struct Inner {
     k: usize,
     step: f32,
+    /// Through the skeleton projection.
     skeleton: bool,
+    /// The foot lock's weight (0: without).
     foot_lock: f32,
+    /// Columns of a head row that move: the root's, or all of them.
+    moving: usize,
+    /// A Polyak step per term.
+    split: bool,
+    /// The root columns' share of each step direction.
+    root_scale: f32,
+}
+
+impl Inner {
+    /// The inner loop at step `i` of the chain (0 = the last): the late additions act in
+    /// the last `late_steps` steps, root-only steps before them.
+    fn at(cfg: &GuideConfig, fused: &FusedSettings, i: usize, k: usize, step: f32) -> Inner {
+        let late = i < cfg.late_steps;
+        Inner {
+            k,
+            step,
+            skeleton: fused.keep_skeleton && late,
+            foot_lock: if late { fused.foot_lock } else { 0.0 },
+            moving: if fused.early_root_only && !late {
+                ROOT_COLUMNS
+            } else {
+                HEAD
+            },
+            // Split in the late steps only: early, where only the path moves, statements
+            // that conflict over the path each pulled it their own way (HSI-4's "duck under
+            // the barrier" met by stopping short of it, against "end past it": 0.76 m short).
+            split: fused.split_terms && cfg.step_rule == StepRule::Polyak && late,
+            root_scale: if late { fused.late_root_scale } else { 1.0 },
+        }
+    }
 }
 
 /// K steps on the head columns of `full` through the fused host path; returns the error
@@ -312,6 +349,9 @@ fn guide_fused(
         step,
         skeleton,
         foot_lock,
+        moving,
+        split,
+        root_scale,
     }: Inner,
     i: usize,
     at: &dyn Fn(usize) -> String,
@@ -326,20 +366,6 @@ fn guide_fused(
     if foot_lock > 0.0 {
         objective.lock_feet(&head, foot_lock);
     }
-    let moving = if cfg.early_root_only && i >= cfg.late_steps {
-        ROOT_COLUMNS
-    } else {
-        HEAD
-    };
-    // Split in the late steps only: early, where only the path moves, statements that
-    // conflict over the path each pulled it their own way (HSI-4's "duck under the barrier"
-    // met by stopping short of it, against "end past it": 0.76 m short).
-    let split = cfg.split_terms && cfg.step_rule == StepRule::Polyak && i < cfg.late_steps;
-    let root_scale = if i < cfg.late_steps {
-        cfg.late_root_scale
-    } else {
-        1.0
-    };
     let mut terms = TermGradients::default();
     let mut combined = vec![0.0; head.len()];
     let mut total = Vec::new();
@@ -592,6 +618,24 @@ pub const SPECS: &[SolverSpec] = &[SolverSpec {
     make: || Solver::new(GuideConfig::default()),
 }];
 
+/// A knob on a field of [`FusedSettings`]. On the graph path (`fused: None`, made only in
+/// code) it reads as the plain update's value, and setting it turns the fused path on with
+/// that one addition.
+macro_rules! fused_knob {
+    ($kind:ident $(($off:literal, $on:literal))?, $name:literal, $doc:expr, $field:ident) => {{
+        const ON_FUSED: Knob<FusedSettings> = knob!($kind $(($off, $on))?, $name, $doc, $field);
+        Knob {
+            name: ON_FUSED.name,
+            doc: ON_FUSED.doc,
+            kind: ON_FUSED.kind,
+            get: |c: &GuideConfig| (ON_FUSED.get)(&c.fused.unwrap_or(FusedSettings::PLAIN)),
+            set: |c: &mut GuideConfig, v| {
+                (ON_FUSED.set)(c.fused.get_or_insert(FusedSettings::PLAIN), v)
+            },
+        }
+    }};
+}
+
 impl SolverConfig for GuideConfig {
     const KNOBS: &'static [Knob<Self>] = &[
         knob!(Count, "steps", "DDPM steps (fewer = respaced chain, faster, rougher)", steps),
@@ -599,7 +643,7 @@ impl SolverConfig for GuideConfig {
         knob!(Count, "k_late", "gradient iterations per step during the last `late_steps`", k_late),
         knob!(Count, "late_steps", "T_s: the last steps that get `k_late` iterations and the late-step additions", late_steps),
         knob!(Real, "tau", "OmniControl's strength τ", tau),
-        knob!(
+        fused_knob!(
             Flag("OmniControl's plain inner loop", "keep bone lengths"),
             "skeleton",
             "1: the last `late_steps` optimise through the skeleton (bone lengths kept, planted feet kept on the floor); 0: OmniControl's plain inner loop",
@@ -612,14 +656,14 @@ impl SolverConfig for GuideConfig {
             freeze_first_frame
         ),
         knob!(Real, "smooth", "σ in frames of the Gaussian each late step's gradient is smoothed with over time; 0: OmniControl's raw gradient", smooth_frames),
-        knob!(Real, "feet", "weight of the slide penalty on planted toes in the last `late_steps`; 0: off", foot_lock),
-        knob!(
+        fused_knob!(Real, "feet", "weight of the slide penalty on planted toes in the last `late_steps`; 0: off", foot_lock),
+        fused_knob!(
             Flag("every column", "root columns only before the late steps"),
             "early_root",
             "1: before the last `late_steps`, step only the root columns (the path) and leave the pose to the model; 0: every column from the first step, as OmniControl",
             early_root_only
         ),
-        knob!(
+        fused_knob!(
             Flag("one step for the whole error", "a step per statement"),
             "split",
             "1: in the last `late_steps`, each statement gets its own step size and the iteration steps along their sum; 0: one step for the whole error, as OmniControl",
@@ -631,7 +675,7 @@ impl SolverConfig for GuideConfig {
             "1: when the model has a ControlNet, every denoising step's x̂0 is steered by it with a hint taken from the program's gradient and the inner loop's iterate (OmniControl's realism guidance); 0: off",
             realism
         ),
-        knob!(Real, "late_root", "share of the root columns (path) in each step of the last `late_steps`, 0–1: the late steps meet contacts and keyframes with the pose instead of by moving the people; 1: OmniControl's plain gradient", late_root_scale),
+        fused_knob!(Real, "late_root", "share of the root columns (path) in each step of the last `late_steps`, 0–1: the late steps meet contacts and keyframes with the pose instead of by moving the people; 1: OmniControl's plain gradient", late_root_scale),
     ];
 
     fn name(&self) -> &'static str {

@@ -17,8 +17,8 @@
 
 use super::bones::SkeletonProjection;
 use super::decode::Decoder;
+use super::driver::host;
 use super::feet::FootLock;
-use super::run::host;
 use super::{MotionError, SolveError};
 use crate::features::layout::RIC;
 use crate::scene::Placement;

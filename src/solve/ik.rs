@@ -17,7 +17,7 @@ use super::SolveError;
 use super::adam::Adam;
 use super::host::{extract_head, insert_head};
 use super::request::{Phase, Progress};
-use super::run::{Ctx, Outcome, check_kind, ensure_finite, host, mean};
+use super::driver::{Ctx, Outcome, check_kind, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
 use crate::model::sampler::SamplerKind;
 

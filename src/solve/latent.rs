@@ -45,11 +45,11 @@ use super::solver::{Solver, SolverConfig, SolverSpec};
 use crate::model::sampler::SamplerKind;
 use super::adam::Adam;
 use super::decode::RigidTensors;
-use super::host::{extract_head, insert_head};
+use super::host::{HostObjective, extract_head, insert_head};
 use crate::scene::Placement;
 use super::reference::ReferencePull;
 use super::request::{Phase, Progress};
-use super::run::{Ctx, Outcome, ensure_finite, host, mean};
+use super::driver::{Ctx, Outcome, ensure_finite, host, mean};
 use super::{SolveError, host::check_shape};
 use crate::features::FEATURE_DIM;
 use super::edit::X0Hold;
@@ -57,6 +57,7 @@ use crate::model::sampler::{Condition, ddim_step, guided_x0};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::model::{Denoiser, Mdm};
 use burn::prelude::*;
+use burn::tensor::Gradients;
 
 /// Whether the motion may move rigidly in the horizontal plane while it is optimised.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -219,19 +220,11 @@ fn run(
     cfg: &LatentConfig,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome, SolveError> {
-    let ad = ctx.device.clone().autodiff();
-    let model = frozen(ctx.prior.model, &ad);
-    let cond = ctx.condition(&ad);
-    let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS).respaced(cfg.ddim_steps);
-    let dims = ctx.dims();
+    let mut chain = Chain::new(ctx, cfg);
     let m = ctx.motions();
-    // An edit starts from its take inverted to the strength's level; strength 0 (no steps)
-    // has nothing to optimise and returns the take.
-    let (first, z0) = ctx.latent_start(&schedule);
-    let iterations = if first == 0 { 1 } else { cfg.iterations };
-    let mut z = host(z0);
-    let hold_ad = ctx.x0_hold_on(&ad);
-    let hold_plain = ctx.x0_hold_on(&ctx.device);
+    let mut z = chain.start();
+    // Strength 0 (no steps) has nothing to optimise: one pass returns the take.
+    let iterations = if chain.first == 0 { 1 } else { cfg.iterations };
     let mut adam = Adam::new(z.len(), cfg.lr);
     let relax = cfg.relax == Relax::RigidXz;
     // [yaw; x; z] × motions.
@@ -239,138 +232,41 @@ fn run(
     let mut adam_rigid = Adam::new(rigid.len(), cfg.relax_lr);
     let mut trace = Vec::with_capacity(iterations);
     let mut last = Vec::new();
-    let plain_model = ctx.denoiser();
-    let plain_cond = ctx.condition(&ctx.device);
-    let skeleton = cfg.keep_skeleton;
-    let placements = |rigid: &[f32]| -> Vec<Placement> {
-        (0..m)
-            .map(|i| Placement {
-                yaw: rigid[i],
-                x: rigid[m + i],
-                z: rigid[2 * m + i],
-            })
-            .collect()
-    };
-    let mut g_rigid = Vec::new();
     let mut objective = ctx.host_objective();
     let pull = ReferencePull::new(cfg.ref_root, cfg.ref_legs);
     // The chain's raw output at iteration 0, which the pull holds the later ones to.
     let mut reference: Option<Vec<f32>> = None;
     for it in 0..iterations {
         let at = || format!("iteration {}/{}", it + 1, iterations);
-        let zt = Tensor::<3>::from_data(TensorData::new(z.clone(), dims), &ad).require_grad();
-        // Forward: the whole graph, or a plain chain keeping each step's input.
-        let (x, inputs) = if cfg.checkpoint {
-            let mut xs = Vec::with_capacity(first);
-            let mut xi = Tensor::<3>::from_data(TensorData::new(z.clone(), dims), &ctx.device);
-            for i in (0..first).rev() {
-                xs.push(xi.clone());
-                xi = ddim_step_held(
-                    &plain_model,
-                    &schedule,
-                    i,
-                    xi,
-                    &plain_cond,
-                    hold_plain.as_ref(),
-                );
-            }
-            let leaf = Tensor::<3>::from_data(xi.into_data(), &ad).require_grad();
-            (leaf, xs)
-        } else {
-            let x = ddim_chain_from(&model, &schedule, first, zt.clone(), &cond, hold_ad.as_ref());
-            (x, Vec::new())
-        };
+        let forward = chain.forward(&z);
         // With the skeleton the rigid move is differentiated on the host, else in burn.
-        let rt = (relax && !skeleton).then(|| {
-            let part = |k: usize| {
-                Tensor::<2>::from_data(
-                    TensorData::new(
-                        rigid[k * m..(k + 1) * m].to_vec(),
-                        [ctx.samples, ctx.people],
-                    ),
-                    &ad,
-                )
-                .require_grad()
-            };
-            RigidTensors {
-                yaw: part(0),
-                x: part(1),
-                z: part(2),
-            }
-        });
-        let (e, values) = if skeleton {
-            // E(P(x̂)) on the host; the chain sees it as ⟨x̂, ∂E/∂x̂⟩.
-            let mut full = host(x.clone().detach());
-            let mut head = extract_head(&full, FEATURE_DIM);
-            objective.project_skeleton(&head);
-            objective.set_rigid(relax.then(|| placements(&rigid)));
-            let mut g_head = vec![0.0; head.len()];
-            let values = objective.eval(&head, &mut g_head)?;
-            g_rigid = objective.rigid_gradient().to_vec();
-            ensure_finite(&values, "latent", "error", at)?;
-            objective.apply_projection(&mut head);
-            objective.stop_projecting();
-            insert_head(&mut full, FEATURE_DIM, &head);
-            last = full;
-            let mut g_full = vec![0.0; last.len()];
-            insert_head(&mut g_full, FEATURE_DIM, &g_head);
-            let g = Tensor::<3>::from_data(TensorData::new(g_full, dims), &ad);
-            ((x.clone() * g).sum().reshape([1]), values)
+        let rt = (relax && !cfg.keep_skeleton).then(|| chain.rigid_tensors(&rigid));
+        let scored = if cfg.keep_skeleton {
+            let placed = relax.then(|| placements(&rigid));
+            chain.score_on_host(&mut objective, &forward.x, placed, at)?
         } else {
-            let e = ctx.error.error(ctx.decoder.joints(x.clone(), rt.as_ref()));
-            check_shape(&e, ctx.samples)?;
-            let values = host(e.clone());
-            ensure_finite(&values, "latent", "error", at)?;
-            last = host(x.clone().detach());
-            (e, values)
+            chain.score_in_graph(&forward.x, rt.as_ref(), at)?
         };
+        last = scored.sample;
         progress(Progress {
             phase: Phase::Optimising,
             done: it + 1,
             total: iterations,
-            error: Some(mean(&values)),
+            error: Some(mean(&scored.values)),
         });
-        trace.push(values);
-        if it + 1 == iterations || !e.is_tracked() {
+        trace.push(scored.values);
+        if it + 1 == iterations || !scored.error.is_tracked() {
             break;
         }
-        let mut loss = e.sum();
-        if let Some(pull) = &pull {
-            let raw = host(x.clone().detach());
-            let reference = reference.get_or_insert_with(|| raw.clone());
-            let mut g = vec![0.0; raw.len()];
-            pull.add(&raw, reference, ctx.frames, &mut g);
-            // ⟨x̂, g⟩ has the pull's gradient at this x̂.
-            let g = Tensor::<3>::from_data(TensorData::new(g, dims), &ad);
-            loss = loss + (x.clone() * g).sum();
-        }
+        let loss = chain.loss_with_pull(scored.error, &forward.x, pull.as_ref(), &mut reference);
         let grads = loss.backward();
-        let gz = if cfg.checkpoint {
-            let g = x
-                .grad(&grads)
-                .map(host)
-                .unwrap_or_else(|| vec![0.0; z.len()]);
-            backprop_steps(&model, &schedule, &cond, hold_ad.as_ref(), inputs, g, &ad)
-        } else {
-            zt.grad(&grads)
-                .map(host)
-                .unwrap_or_else(|| vec![0.0; z.len()])
-        };
+        let gz = chain.noise_gradient(forward, &grads, z.len());
         ensure_finite(&gz, "latent", "gradient", at)?;
         adam.step(&mut z, &gz);
         if relax {
             let g = match &rt {
-                Some(r) => {
-                    let mut g = Vec::with_capacity(3 * m);
-                    for t in [&r.yaw, &r.x, &r.z] {
-                        match t.grad(&grads) {
-                            Some(v) => g.extend(v.into_data().try_to_vec::<f32>().expect("f32")),
-                            None => g.extend(std::iter::repeat_n(0.0, m)),
-                        }
-                    }
-                    g
-                }
-                None => std::mem::take(&mut g_rigid),
+                Some(r) => rigid_gradient(r, &grads, m),
+                None => scored.rigid_gradient,
             };
             ensure_finite(&g, "latent", "gradient", at)?;
             adam_rigid.step(&mut rigid, &g);
@@ -378,7 +274,7 @@ fn run(
     }
     let relax = relax.then(|| placements(&rigid));
     if ctx.edit.is_some() {
-        let x = Tensor::<3>::from_data(TensorData::new(last, dims), &ctx.device);
+        let x = Tensor::<3>::from_data(TensorData::new(last, ctx.dims()), &ctx.device);
         last = host(ctx.hold_final(x));
     }
     Ok(Outcome {
@@ -386,6 +282,256 @@ fn run(
         relax,
         trace,
     })
+}
+
+/// The rigid moves `[yaw; x; z] × motions` as placements, one per motion.
+fn placements(rigid: &[f32]) -> Vec<Placement> {
+    let m = rigid.len() / 3;
+    (0..m)
+        .map(|i| Placement {
+            yaw: rigid[i],
+            x: rigid[m + i],
+            z: rigid[2 * m + i],
+        })
+        .collect()
+}
+
+/// ∂E/∂(yaw, x, z) of the rigid moves differentiated in burn, `[yaw; x; z] × m`.
+fn rigid_gradient(r: &RigidTensors, grads: &Gradients, m: usize) -> Vec<f32> {
+    let mut g = Vec::with_capacity(3 * m);
+    for t in [&r.yaw, &r.x, &r.z] {
+        match t.grad(grads) {
+            Some(v) => g.extend(v.into_data().try_to_vec::<f32>().expect("f32")),
+            None => g.extend(std::iter::repeat_n(0.0, m)),
+        }
+    }
+    g
+}
+
+/// The DDIM chain as `latent` runs it: on a frozen autodiff copy of the model, or (with
+/// `checkpoint`) forward on the plain model and backward one step at a time.
+struct Chain<'a, 'c> {
+    ctx: &'a Ctx<'c>,
+    checkpoint: bool,
+    ad: Device,
+    model: Mdm,
+    cond: Condition,
+    schedule: NoiseSchedule,
+    plain_model: Mdm,
+    plain_cond: Condition,
+    /// Steps the chain runs (`first − 1` down to 0): all of them, or an edit's part.
+    first: usize,
+    /// An edit's held x̂0, on the autodiff device and on the plain one.
+    hold_ad: Option<X0Hold>,
+    hold_plain: Option<X0Hold>,
+}
+
+/// One forward pass from z.
+struct Forward {
+    /// z as an autodiff leaf (the whole graph hangs from it without checkpointing).
+    zt: Tensor<3>,
+    /// The chain's output x̂ (with checkpointing an autodiff leaf of its own).
+    x: Tensor<3>,
+    /// With checkpointing, each step's input, first step first.
+    inputs: Vec<Tensor<3>>,
+}
+
+/// The error of one forward pass.
+struct Scored {
+    /// Per sample `[B]`, to differentiate (with the skeleton, `⟨x̂, ∂E/∂x̂⟩` summed).
+    error: Tensor<1>,
+    /// Per sample, on the host.
+    values: Vec<f32>,
+    /// What the iteration returns: x̂, or `P(x̂)` with the skeleton.
+    sample: Vec<f32>,
+    /// With the skeleton, ∂E/∂(yaw, x, z) of the rigid moves, from the host.
+    rigid_gradient: Vec<f32>,
+}
+
+impl<'a, 'c> Chain<'a, 'c> {
+    fn new(ctx: &'a Ctx<'c>, cfg: &LatentConfig) -> Self {
+        let ad = ctx.device.clone().autodiff();
+        let model = frozen(ctx.prior.model, &ad);
+        let cond = ctx.condition(&ad);
+        let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS).respaced(cfg.ddim_steps);
+        Chain {
+            ctx,
+            checkpoint: cfg.checkpoint,
+            model,
+            cond,
+            first: schedule.len(),
+            schedule,
+            plain_model: ctx.denoiser(),
+            plain_cond: ctx.condition(&ctx.device),
+            hold_ad: ctx.x0_hold_on(&ad),
+            hold_plain: ctx.x0_hold_on(&ctx.device),
+            ad,
+        }
+    }
+
+    /// Where the optimisation starts: z, and the chain set to run from it. An edit starts
+    /// from its take inverted to the strength's level ([`Ctx::latent_start`]).
+    fn start(&mut self) -> Vec<f32> {
+        let (first, z) = self.ctx.latent_start(&self.schedule);
+        self.first = first;
+        host(z)
+    }
+
+    /// Forward: the whole graph, or a plain chain keeping each step's input.
+    fn forward(&self, z: &[f32]) -> Forward {
+        let (dims, ad) = (self.ctx.dims(), &self.ad);
+        let zt = Tensor::<3>::from_data(TensorData::new(z.to_vec(), dims), ad).require_grad();
+        if !self.checkpoint {
+            let x = ddim_chain_from(
+                &self.model,
+                &self.schedule,
+                self.first,
+                zt.clone(),
+                &self.cond,
+                self.hold_ad.as_ref(),
+            );
+            return Forward {
+                zt,
+                x,
+                inputs: Vec::new(),
+            };
+        }
+        let schedule = &self.schedule;
+        let mut inputs = Vec::with_capacity(self.first);
+        let mut xi = Tensor::<3>::from_data(TensorData::new(z.to_vec(), dims), &self.ctx.device);
+        for i in (0..self.first).rev() {
+            inputs.push(xi.clone());
+            xi = ddim_step_held(
+                &self.plain_model,
+                schedule,
+                i,
+                xi,
+                &self.plain_cond,
+                self.hold_plain.as_ref(),
+            );
+        }
+        let x = Tensor::<3>::from_data(xi.into_data(), ad).require_grad();
+        Forward { zt, x, inputs }
+    }
+
+    /// The rigid moves as autodiff leaves `[samples, people]` each.
+    fn rigid_tensors(&self, rigid: &[f32]) -> RigidTensors {
+        let (ctx, m) = (self.ctx, self.ctx.motions());
+        let part = |k: usize| {
+            Tensor::<2>::from_data(
+                TensorData::new(rigid[k * m..(k + 1) * m].to_vec(), [ctx.samples, ctx.people]),
+                &self.ad,
+            )
+            .require_grad()
+        };
+        RigidTensors {
+            yaw: part(0),
+            x: part(1),
+            z: part(2),
+        }
+    }
+
+    /// E(P(x̂)) on the host; the chain sees it as ⟨x̂, ∂E/∂x̂⟩.
+    fn score_on_host(
+        &self,
+        objective: &mut HostObjective,
+        x: &Tensor<3>,
+        placed: Option<Vec<Placement>>,
+        at: impl FnOnce() -> String,
+    ) -> Result<Scored, SolveError> {
+        let mut full = host(x.clone().detach());
+        let mut head = extract_head(&full, FEATURE_DIM);
+        objective.project_skeleton(&head);
+        objective.set_rigid(placed);
+        let mut g_head = vec![0.0; head.len()];
+        let values = objective.eval(&head, &mut g_head)?;
+        let rigid_gradient = objective.rigid_gradient().to_vec();
+        ensure_finite(&values, "latent", "error", at)?;
+        objective.apply_projection(&mut head);
+        objective.stop_projecting();
+        insert_head(&mut full, FEATURE_DIM, &head);
+        let mut g_full = vec![0.0; full.len()];
+        insert_head(&mut g_full, FEATURE_DIM, &g_head);
+        let g = Tensor::<3>::from_data(TensorData::new(g_full, self.ctx.dims()), &self.ad);
+        Ok(Scored {
+            error: (x.clone() * g).sum().reshape([1]),
+            values,
+            sample: full,
+            rigid_gradient,
+        })
+    }
+
+    /// E(x̂) through the burn decoder (and the rigid moves, when relaxed).
+    fn score_in_graph(
+        &self,
+        x: &Tensor<3>,
+        rt: Option<&RigidTensors>,
+        at: impl FnOnce() -> String,
+    ) -> Result<Scored, SolveError> {
+        let ctx = self.ctx;
+        let e = ctx.error.error(ctx.decoder.joints(x.clone(), rt));
+        check_shape(&e, ctx.samples)?;
+        let values = host(e.clone());
+        ensure_finite(&values, "latent", "error", at)?;
+        Ok(Scored {
+            error: e,
+            values,
+            sample: host(x.clone().detach()),
+            rigid_gradient: Vec::new(),
+        })
+    }
+
+    /// The summed error plus, with a reference pull, ⟨x̂, g⟩ with g the pull's gradient
+    /// at this x̂ (the first iteration's x̂ becomes the reference).
+    fn loss_with_pull(
+        &self,
+        error: Tensor<1>,
+        x: &Tensor<3>,
+        pull: Option<&ReferencePull>,
+        reference: &mut Option<Vec<f32>>,
+    ) -> Tensor<1> {
+        let loss = error.sum();
+        let Some(pull) = pull else {
+            return loss;
+        };
+        let raw = host(x.clone().detach());
+        let reference = reference.get_or_insert_with(|| raw.clone());
+        let mut g = vec![0.0; raw.len()];
+        pull.add(&raw, reference, self.ctx.frames, &mut g);
+        let g = Tensor::<3>::from_data(TensorData::new(g, self.ctx.dims()), &self.ad);
+        loss + (x.clone() * g).sum()
+    }
+
+    /// ∂loss/∂z (`len` values): read off z, or back-propagated step by step from x̂.
+    fn noise_gradient(
+        &self,
+        forward: Forward,
+        grads: &Gradients,
+        len: usize,
+    ) -> Vec<f32> {
+        if self.checkpoint {
+            let g = forward
+                .x
+                .grad(grads)
+                .map(host)
+                .unwrap_or_else(|| vec![0.0; len]);
+            backprop_steps(
+                &self.model,
+                &self.schedule,
+                &self.cond,
+                self.hold_ad.as_ref(),
+                forward.inputs,
+                g,
+                &self.ad,
+            )
+        } else {
+            forward
+                .zt
+                .grad(grads)
+                .map(host)
+                .unwrap_or_else(|| vec![0.0; len])
+        }
+    }
 }
 
 /// `latent`, for [`super::registry`].

@@ -39,9 +39,9 @@ use super::solver::{Solver, SolverConfig, SolverSpec};
 use crate::model::sampler::SamplerKind;
 use super::SolveError;
 use super::guide::smooth_over_frames;
-use super::host::{HEAD, check_shape, extract_head, insert_head};
+use super::host::{HEAD, HostObjective, check_shape, extract_head, insert_head};
 use super::request::{Phase, Progress};
-use super::run::{Ctx, Outcome, ensure_finite, host, mean};
+use super::driver::{Ctx, Outcome, ensure_finite, host, mean};
 use crate::features::FEATURE_DIM;
 use super::realism::Realism;
 use crate::model::sampler::posterior_mean;
@@ -49,7 +49,6 @@ use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use burn::module::Param;
 use burn::optim::{GradientsParams, LBFGSConfig, LineSearchFn};
 use burn::prelude::*;
-use std::cell::Cell;
 
 /// Settings of `lbfgs`.
 #[derive(Clone, Debug, PartialEq)]
@@ -168,142 +167,14 @@ fn run(
         let x0 = realism.x0(&den, x.clone(), schedule.timesteps[i], &cond);
         let mu = posterior_mean(&schedule, i, x, x0);
         let before = (realism.is_on() && (cfg.k_first > 0 || cfg.k_last > 0)).then(|| host(mu.clone()));
-        let k = if i < cfg.late_steps {
-            cfg.k_last
-        } else {
-            cfg.k_first
-        };
         let at = || format!("denoising step {}/{n}", n - i);
-        let skeleton = cfg.keep_skeleton && i < cfg.late_steps && k > 0;
-        // Root-only steps: the gradient is masked to the root columns, so every L-BFGS
-        // direction (built from gradients) and its line search stay in that subspace.
-        let root_only = early_mask.as_ref().filter(|_| i >= cfg.late_steps);
-        let mu_head = skeleton.then(|| extract_head(&host(mu.clone()), FEATURE_DIM));
-        if let Some(head) = &mu_head {
-            objective.project_skeleton(head);
-        }
-        // Smoothed late steps optimise y (from 0) in μ + S·y; `base` holds μ's heads.
-        let sigma = cfg.smooth_frames;
-        let base = mu_head.filter(|_| sigma > 0.0);
-        let mu_before = mu.clone();
-        let start = match base {
-            Some(_) => mu.zeros_like(),
-            None => mu,
-        };
-        let edit = |y: &[f32]| -> Vec<f32> {
-            let base = base.as_ref().expect("smoothed steps");
-            let sy = smooth_over_frames(&extract_head(y, FEATURE_DIM), ctx.frames, HEAD, sigma);
-            base.iter().zip(sy).map(|(b, d)| b + d).collect()
-        };
-        let mut module = Mu {
-            x: Param::from_tensor(Tensor::from_data(start.into_data(), &ad).require_grad()),
-        };
-        let mut lbfgs = optimiser.init();
-        let bad: Cell<Option<SolveError>> = Cell::new(None);
-        let mut last: Vec<f32> = Vec::new();
-        for _ in 0..k {
-            let mut closure = |m: Mu| -> (f64, GradientsParams) {
-                let mut grads = GradientsParams::new();
-                if skeleton {
-                    // E(P(μ)) and its gradient through the fused host path.
-                    let full = host(m.x.val().detach());
-                    let head = match base {
-                        Some(_) => edit(&full),
-                        None => extract_head(&full, FEATURE_DIM),
-                    };
-                    let mut g_head = vec![0.0; head.len()];
-                    let value = match objective.eval(&head, &mut g_head) {
-                        Ok(values) => {
-                            let sum = values.iter().map(|&v| v as f64).sum::<f64>();
-                            if !sum.is_finite() {
-                                bad.set(Some(SolveError::NonFinite {
-                                    solver: "lbfgs",
-                                    what: "error",
-                                    at: at(),
-                                }));
-                            }
-                            last = values;
-                            sum
-                        }
-                        Err(err) => {
-                            bad.set(Some(err));
-                            f64::NAN
-                        }
-                    };
-                    if base.is_some() {
-                        // ∂E/∂y = Sᵀ·∂E/∂x, and S is symmetric.
-                        g_head = smooth_over_frames(&g_head, ctx.frames, HEAD, sigma);
-                    }
-                    let mut g = vec![0.0; full.len()];
-                    insert_head(&mut g, FEATURE_DIM, &g_head);
-                    grads.register(
-                        m.x.id,
-                        Tensor::<3>::from_data(TensorData::new(g, dims), &ctx.device),
-                    );
-                    return (value, grads);
-                }
-                let e = ctx.error.error(ctx.decoder.joints(m.x.val(), None));
-                if let Err(err) = check_shape(&e, ctx.samples) {
-                    bad.set(Some(err));
-                    grads.register(m.x.id, Tensor::<3>::zeros(dims, &ctx.device));
-                    return (f64::NAN, grads);
-                }
-                last = host(e.clone());
-                let total = e.sum();
-                let value = total.clone().into_scalar::<f64>();
-                if !value.is_finite() {
-                    bad.set(Some(SolveError::NonFinite {
-                        solver: "lbfgs",
-                        what: "error",
-                        at: at(),
-                    }));
-                }
-                if total.is_tracked() {
-                    grads = GradientsParams::from_grads(total.backward(), &m);
-                }
-                let g = grads
-                    .remove::<3>(m.x.id)
-                    .unwrap_or_else(|| Tensor::zeros(dims, &ctx.device));
-                let g = match root_only {
-                    Some(mask) => g * mask.clone(),
-                    None => g,
-                };
-                grads.register(m.x.id, g);
-                (value, grads)
-            };
-            let (next, loss) = lbfgs.step(cfg.lr, module, &mut closure);
-            module = next;
-            if let Some(err) = bad.take() {
-                return Err(err);
-            }
-            ensure_finite(&[loss as f32], "lbfgs", "error", at)?;
-        }
-        let y = Tensor::<3>::from_data(module.x.val().detach().into_data(), &ctx.device);
-        let mut mu = match &base {
-            // y was zero outside the heads and got no gradient there: μ's other columns.
-            Some(_) => {
-                let mut full = host(mu_before);
-                insert_head(&mut full, FEATURE_DIM, &edit(&host(y)));
-                Tensor::from_data(TensorData::new(full, dims), &ctx.device)
-            }
-            None => y,
-        };
-        if skeleton {
-            // The error was of P(μ): make that what the chain carries on with.
-            let mut full = host(mu);
-            let mut head = extract_head(&full, FEATURE_DIM);
-            objective.apply_projection(&mut head);
-            objective.stop_projecting();
-            insert_head(&mut full, FEATURE_DIM, &head);
-            mu = Tensor::from_data(TensorData::new(full, dims), &ctx.device);
-        }
-        let values = if k > 0 {
-            ensure_finite(&last, "lbfgs", "error", at)?;
-            trace.push(last.clone());
-            Some(mean(&last))
-        } else {
-            None
-        };
+        let problem = StepProblem::at(ctx, cfg, i, &ad, early_mask.as_ref(), &at);
+        let (mu, last) = problem.solve(cfg, &optimiser, &mut objective, mu)?;
+        let values = last.map(|last| {
+            let m = mean(&last);
+            trace.push(last);
+            m
+        });
         ensure_finite(&host(mu.clone()), "lbfgs", "sample", at)?;
         if let Some(before) = before {
             realism.update(ctx, &before, &host(mu.clone()))?;
@@ -325,6 +196,227 @@ fn run(
         relax: None,
         trace,
     })
+}
+
+/// One denoising step's L-BFGS problem: how many `step` calls, and how the error of μ is
+/// evaluated (through the skeleton projection on the fused host path, or the burn graph).
+struct StepProblem<'a, 'c> {
+    ctx: &'a Ctx<'c>,
+    /// The autodiff device the optimised variable lives on.
+    ad: &'a Device,
+    /// `step` calls.
+    k: usize,
+    /// E(P(μ)) through the fused host path, P(μ) written back.
+    skeleton: bool,
+    /// Root-only steps: the gradient is masked to the root columns, so every L-BFGS
+    /// direction (built from gradients) and its line search stay in that subspace.
+    root_only: Option<&'a Tensor<3>>,
+    /// σ (frames) of the edit's smoothing over time.
+    sigma: f32,
+    /// Where in the chain, for error messages.
+    at: &'a dyn Fn() -> String,
+}
+
+/// What the evaluations of one L-BFGS run leave behind: the last error per sample, and a
+/// failure to report once `step` returns (L-BFGS itself cannot be told).
+#[derive(Default)]
+struct Evaluations {
+    last: Vec<f32>,
+    failure: Option<SolveError>,
+}
+
+impl<'a, 'c> StepProblem<'a, 'c> {
+    /// The problem at step `i` of the chain (0 = the last): the late steps keep the
+    /// skeleton and call L-BFGS `k_last` times, the earlier ones `k_first` times.
+    fn at(
+        ctx: &'a Ctx<'c>,
+        cfg: &LbfgsConfig,
+        i: usize,
+        ad: &'a Device,
+        early_mask: Option<&'a Tensor<3>>,
+        at: &'a dyn Fn() -> String,
+    ) -> Self {
+        let late = i < cfg.late_steps;
+        let k = if late { cfg.k_last } else { cfg.k_first };
+        StepProblem {
+            ctx,
+            ad,
+            k,
+            skeleton: cfg.keep_skeleton && late && k > 0,
+            root_only: early_mask.filter(|_| !late),
+            sigma: cfg.smooth_frames,
+            at,
+        }
+    }
+
+    /// The new μ, and the last error per sample when L-BFGS ran (`k` > 0).
+    fn solve(
+        &self,
+        cfg: &LbfgsConfig,
+        optimiser: &LBFGSConfig,
+        objective: &mut HostObjective,
+        mu: Tensor<3>,
+    ) -> Result<(Tensor<3>, Option<Vec<f32>>), SolveError> {
+        let (ctx, dims) = (self.ctx, self.ctx.dims());
+        let mu_head = self.skeleton.then(|| extract_head(&host(mu.clone()), FEATURE_DIM));
+        if let Some(head) = &mu_head {
+            objective.project_skeleton(head);
+        }
+        // Smoothed late steps optimise y (from 0) in μ + S·y; `base` holds μ's heads.
+        let base = mu_head.filter(|_| self.sigma > 0.0);
+        let mu_before = mu.clone();
+        let start = match base {
+            Some(_) => mu.zeros_like(),
+            None => mu,
+        };
+        let (y, last) = self.minimise(cfg.lr, optimiser, objective, base.as_deref(), start)?;
+        let mut mu = match &base {
+            // y was zero outside the heads and got no gradient there: μ's other columns.
+            Some(base) => {
+                let mut full = host(mu_before);
+                insert_head(&mut full, FEATURE_DIM, &self.edit(base, &host(y)));
+                Tensor::from_data(TensorData::new(full, dims), &ctx.device)
+            }
+            None => y,
+        };
+        if self.skeleton {
+            // The error was of P(μ): make that what the chain carries on with.
+            let mut full = host(mu);
+            let mut head = extract_head(&full, FEATURE_DIM);
+            objective.apply_projection(&mut head);
+            objective.stop_projecting();
+            insert_head(&mut full, FEATURE_DIM, &head);
+            mu = Tensor::from_data(TensorData::new(full, dims), &ctx.device);
+        }
+        if self.k == 0 {
+            return Ok((mu, None));
+        }
+        ensure_finite(&last, "lbfgs", "error", self.at)?;
+        Ok((mu, Some(last)))
+    }
+
+    /// `k` L-BFGS `step` calls from `start`; returns the optimised variable (μ, or y of
+    /// μ + S·y when `base` is given) and the last error per sample.
+    fn minimise(
+        &self,
+        lr: f64,
+        optimiser: &LBFGSConfig,
+        objective: &mut HostObjective,
+        base: Option<&[f32]>,
+        start: Tensor<3>,
+    ) -> Result<(Tensor<3>, Vec<f32>), SolveError> {
+        let mut module = Mu {
+            x: Param::from_tensor(Tensor::from_data(start.into_data(), self.ad).require_grad()),
+        };
+        let mut lbfgs = optimiser.init();
+        let mut evals = Evaluations::default();
+        for _ in 0..self.k {
+            let closure = |m: Mu| {
+                if self.skeleton {
+                    self.eval_host(objective, base, &m, &mut evals)
+                } else {
+                    self.eval_graph(&m, &mut evals)
+                }
+            };
+            let (next, loss) = lbfgs.step(lr, module, closure);
+            module = next;
+            if let Some(err) = evals.failure.take() {
+                return Err(err);
+            }
+            ensure_finite(&[loss as f32], "lbfgs", "error", self.at)?;
+        }
+        let y = Tensor::<3>::from_data(module.x.val().detach().into_data(), &self.ctx.device);
+        Ok((y, evals.last))
+    }
+
+    /// μ's heads `base` plus the smoothed heads of `y`: S·y.
+    fn edit(&self, base: &[f32], y: &[f32]) -> Vec<f32> {
+        let sy = smooth_over_frames(&extract_head(y, FEATURE_DIM), self.ctx.frames, HEAD, self.sigma);
+        base.iter().zip(sy).map(|(b, d)| b + d).collect()
+    }
+
+    /// E(P(μ)) and its gradient through the fused host path (of μ = base + S·y when
+    /// smoothed: the gradient is then ∂E/∂y).
+    fn eval_host(
+        &self,
+        objective: &mut HostObjective,
+        base: Option<&[f32]>,
+        m: &Mu,
+        evals: &mut Evaluations,
+    ) -> (f64, GradientsParams) {
+        let ctx = self.ctx;
+        let mut grads = GradientsParams::new();
+        let full = host(m.x.val().detach());
+        let head = match base {
+            Some(base) => self.edit(base, &full),
+            None => extract_head(&full, FEATURE_DIM),
+        };
+        let mut g_head = vec![0.0; head.len()];
+        let value = match objective.eval(&head, &mut g_head) {
+            Ok(values) => {
+                let sum = values.iter().map(|&v| v as f64).sum::<f64>();
+                if !sum.is_finite() {
+                    evals.failure = Some(self.non_finite());
+                }
+                evals.last = values;
+                sum
+            }
+            Err(err) => {
+                evals.failure = Some(err);
+                f64::NAN
+            }
+        };
+        if base.is_some() {
+            // ∂E/∂y = Sᵀ·∂E/∂x, and S is symmetric.
+            g_head = smooth_over_frames(&g_head, ctx.frames, HEAD, self.sigma);
+        }
+        let mut g = vec![0.0; full.len()];
+        insert_head(&mut g, FEATURE_DIM, &g_head);
+        grads.register(
+            m.x.id,
+            Tensor::<3>::from_data(TensorData::new(g, ctx.dims()), &ctx.device),
+        );
+        (value, grads)
+    }
+
+    /// The error of the decoded μ and its gradient through the burn graph (masked to the
+    /// root columns on root-only steps).
+    fn eval_graph(&self, m: &Mu, evals: &mut Evaluations) -> (f64, GradientsParams) {
+        let (ctx, dims) = (self.ctx, self.ctx.dims());
+        let mut grads = GradientsParams::new();
+        let e = ctx.error.error(ctx.decoder.joints(m.x.val(), None));
+        if let Err(err) = check_shape(&e, ctx.samples) {
+            evals.failure = Some(err);
+            grads.register(m.x.id, Tensor::<3>::zeros(dims, &ctx.device));
+            return (f64::NAN, grads);
+        }
+        evals.last = host(e.clone());
+        let total = e.sum();
+        let value = total.clone().into_scalar::<f64>();
+        if !value.is_finite() {
+            evals.failure = Some(self.non_finite());
+        }
+        if total.is_tracked() {
+            grads = GradientsParams::from_grads(total.backward(), m);
+        }
+        let g = grads
+            .remove::<3>(m.x.id)
+            .unwrap_or_else(|| Tensor::zeros(dims, &ctx.device));
+        let g = match self.root_only {
+            Some(mask) => g * mask.clone(),
+            None => g,
+        };
+        grads.register(m.x.id, g);
+        (value, grads)
+    }
+
+    fn non_finite(&self) -> SolveError {
+        SolveError::NonFinite {
+            solver: "lbfgs",
+            what: "error",
+            at: (self.at)(),
+        }
+    }
 }
 
 /// `lbfgs`, for [`super::registry`].

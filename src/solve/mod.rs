@@ -53,6 +53,7 @@ pub mod adam;
 pub mod bones;
 pub mod cleanup;
 mod decode;
+mod driver;
 pub mod edit;
 pub mod feet;
 pub mod host;
@@ -60,7 +61,6 @@ pub mod knobs;
 mod realism;
 pub mod reference;
 mod request;
-mod run;
 mod solver;
 pub mod take;
 
@@ -98,18 +98,18 @@ mod tests;
 
 pub use crate::scene::{DEFAULT_SPACING, Placement};
 pub use decode::{Decoder, RigidTensors};
+pub use driver::{Ctx, Outcome, solve};
 pub use edit::{
     AutoHold, BODY_PARTS, DEFAULT_BLEND, DEFAULT_RESAMPLE, DEFAULT_STRENGTH, Edit, auto_hold,
     hold_weights, in_between_hold, parts_joints,
 };
-pub use guide::{GuideConfig, StepRule, VarianceRule};
+pub use guide::{FusedSettings, GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;
 pub use knobs::{KnobKind, KnobValue};
 pub use latent::{LatentConfig, Relax};
 pub use lbfgs::LbfgsConfig;
 pub use plain::PlainConfig;
 pub use request::{Phase, Prior, Progress, SolveRequest, SolveResult};
-pub use run::{Ctx, Outcome, solve};
 pub use solver::{Solver, SolverConfig, SolverSpec, solvers_help};
 pub use take::Take;
 

@@ -3,7 +3,7 @@
 use super::SolveError;
 use super::knobs::{Knob, KnobKind};
 use super::request::Progress;
-use super::run::{Ctx, Outcome, check_kind, host};
+use super::driver::{Ctx, Outcome, check_kind, host};
 use super::solver::{Solver, SolverConfig, SolverSpec};
 use crate::model::sampler::SamplerKind;
 

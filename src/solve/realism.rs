@@ -17,7 +17,7 @@
 //! the places the inner loop put them (the targets, once it has met them).
 
 use super::SolveError;
-use super::run::{Ctx, host};
+use super::driver::{Ctx, host};
 use crate::features::recover_from_ric_tensor;
 use crate::model::Denoiser;
 use crate::model::control::{ControlNet, Controlled, Hint};

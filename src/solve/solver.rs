@@ -4,9 +4,9 @@
 //! [`super::registry`].
 
 use super::SolveError;
+use super::driver::{Ctx, Outcome};
 use super::knobs::{Knob, KnobValue, check};
 use super::request::Progress;
-use super::run::{Ctx, Outcome};
 use crate::model::sampler::SamplerKind;
 use std::any::Any;
 use std::fmt;

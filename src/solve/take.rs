@@ -7,7 +7,7 @@
 //! [`Take::splice`] builds the take of an in-between: the end of one take, a gap for the
 //! model to fill, the start of another.
 
-use crate::features::ik::{body_facing, poses_f64};
+use crate::features::kinematics::{body_facing, poses_f64};
 use crate::features::{ExtractOptions, FEATURE_DIM, FeatureError, extract, recover_from_ric};
 use crate::motion::Motion;
 use crate::scene::Placement;

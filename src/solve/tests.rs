@@ -649,10 +649,13 @@ fn fused_and_graph_guidance_agree() {
     let cfg = GuideConfig {
         steps: 10,
         k_late: 30,
-        keep_skeleton: false,
-        foot_lock: 0.0,
-        early_root_only: false,
-        split_terms: false,
+        fused: Some(FusedSettings {
+            keep_skeleton: false,
+            foot_lock: 0.0,
+            early_root_only: false,
+            split_terms: false,
+            ..FusedSettings::default()
+        }),
         ..GuideConfig::default()
     };
     let fused = run(
@@ -664,10 +667,7 @@ fn fused_and_graph_guidance_agree() {
         &bundle,
         &request(
             &["a person walks"],
-            Solver::new(GuideConfig {
-                fused: false,
-                ..cfg
-            }),
+            Solver::new(GuideConfig { fused: None, ..cfg }),
         ),
         &pelvis_at_end,
     );
@@ -829,7 +829,10 @@ fn guide_keeps_the_skeleton_in_its_late_steps() {
     check_keeps_the_skeleton(|keep_skeleton| {
         Solver::new(GuideConfig {
             steps: 50,
-            keep_skeleton,
+            fused: Some(FusedSettings {
+                keep_skeleton,
+                ..FusedSettings::default()
+            }),
             ..GuideConfig::default()
         })
     });
@@ -897,7 +900,10 @@ fn a_first_frame_target_is_met_unless_the_frame_is_frozen() {
         let cfg = GuideConfig {
             steps: 50,
             freeze_first_frame,
-            late_root_scale: 1.0,
+            fused: Some(FusedSettings {
+                late_root_scale: 1.0,
+                ..FusedSettings::default()
+            }),
             ..GuideConfig::default()
         };
         run(
@@ -958,7 +964,10 @@ fn early_steps_steer_the_root_and_leave_the_pose_to_the_denoiser() {
         let cfg = GuideConfig {
             steps: 20,
             late_steps: 0,
-            early_root_only,
+            fused: Some(FusedSettings {
+                early_root_only,
+                ..FusedSettings::default()
+            }),
             ..GuideConfig::default()
         };
         run(
@@ -1166,7 +1175,10 @@ fn a_stiff_statement_does_not_set_the_pace_of_the_others() {
             steps: 20,
             k_late: 30,
             late_steps: 3,
-            split_terms,
+            fused: Some(FusedSettings {
+                split_terms,
+                ..FusedSettings::default()
+            }),
             ..GuideConfig::default()
         };
         run(
@@ -1229,7 +1241,10 @@ fn late_root_scale_leaves_the_path_and_moves_the_pose() {
             steps: 20,
             late_steps: 20,
             k_late: 30,
-            late_root_scale,
+            fused: Some(FusedSettings {
+                late_root_scale,
+                ..FusedSettings::default()
+            }),
             ..GuideConfig::default()
         })
     };
@@ -1257,7 +1272,7 @@ fn late_root_scale_leaves_the_path_and_moves_the_pose() {
     let mut knob = guide(1.0);
     knob.set_knob("late_root", 0.01).unwrap();
     let c = knob.config::<GuideConfig>().expect("guide settings");
-    assert_eq!(c.late_root_scale, 0.01);
+    assert_eq!(c.fused.map(|f| f.late_root_scale), Some(0.01));
     knob.set_knob("late_root", 1.5).unwrap();
     assert_refused(&bundle, knob, "late_root");
 }

@@ -7,7 +7,7 @@ use super::SolveError;
 use super::host::{extract_head, insert_head};
 use super::knobs::{Knob, knob};
 use super::request::Progress;
-use super::run::{Ctx, Outcome, ensure_finite, host};
+use super::driver::{Ctx, Outcome, ensure_finite, host};
 use super::solver::{Solver, SolverConfig, SolverSpec};
 use crate::features::FEATURE_DIM;
 use crate::model::sampler::SamplerKind;
@@ -52,7 +52,7 @@ impl SolverConfig for ToyConfig {
     }
 
     fn validate(&self) -> Result<(), SolveError> {
-        super::run::check_kind(self.unguided())
+        super::driver::check_kind(self.unguided())
     }
 
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {

@@ -20,7 +20,7 @@ mod tests;
 use super::outputs::OutputJob;
 use super::rig;
 use crate::features::FeatureError;
-use crate::features::ik;
+use crate::features::kinematics;
 use crate::motion::Motion;
 use document::{
     Accessor, Animation, Asset, Buffer, BufferView, Channel, Document, FLOAT, Node, Sampler, Scene,
@@ -89,7 +89,7 @@ impl Builder {
                 needed: 1,
             });
         }
-        let poses = ik::poses_f64(m)?;
+        let poses = kinematics::poses_f64(m)?;
         let nodes = rig::hierarchy();
         let lengths = rig::mean_bone_lengths(&poses);
         let mut rotations = Vec::with_capacity(poses.len());

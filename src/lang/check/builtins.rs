@@ -1,5 +1,5 @@
 //! The table of built-in (Rust) functions: names, arities and documentation. Their
-//! meaning is implemented in `calls.rs`; library functions written in mprog live in
+//! meaning is implemented in `calls.rs` (numeric ones in `numeric.rs`); library functions written in mprog live in
 //! `stdlib/*.mprog`.
 
 /// One built-in function.

@@ -188,7 +188,9 @@ impl<'a> Checker<'a> {
         out.into_iter().collect()
     }
 
-    fn want(&mut self, n: &Num, vector: bool, e: &Expr, fname: &str, cx: &Cx) -> bool {
+    /// Whether `n` is a vector (`vector`) or a scalar, as argument `e` of `fname` must be;
+    /// reports it when not.
+    pub(super) fn want(&mut self, n: &Num, vector: bool, e: &Expr, fname: &str, cx: &Cx) -> bool {
         if n.vector == vector {
             return true;
         }
@@ -440,167 +442,9 @@ impl<'a> Checker<'a> {
         self.normalize(fwd, span)
     }
 
-    fn normalize(&mut self, v: usize, span: Span) -> usize {
+    /// `v / norm(v)`.
+    pub(super) fn normalize(&mut self, v: usize, span: Span) -> usize {
         let n = self.b.norm(v, span);
         self.b.binary(BinaryOp::Div, v, n, span)
-    }
-
-    fn numeric_builtin(
-        &mut self,
-        b: &BuiltinDoc,
-        v: &[Num],
-        args: &'a [Expr],
-        span: Span,
-        cx: &Cx,
-    ) -> Val {
-        let name = b.name;
-        let unify = |s: &mut Self, x: &Num, y: &Num| -> Option<Unit> {
-            let u = x.unit.unify(y.unit);
-            if u.is_none() {
-                s.error(
-                    cx,
-                    crate::lang::codes::UNIT_MISMATCH,
-                    span,
-                    format!("`{name}` mixes {} and {}", x.unit, y.unit),
-                )
-                .label(format!("{} vs {}", x.unit, y.unit))
-                .help(super::ops::unit_hint(x.unit, y.unit));
-            }
-            u
-        };
-        let out = |node, unit, vector| Val::Num(Num { node, unit, vector });
-        match name {
-            "norm" | "normalize" => {
-                if !self.want(&v[0], true, &args[0], name, cx) {
-                    return Val::Error;
-                }
-                if name == "norm" {
-                    out(self.b.norm(v[0].node, span), v[0].unit, false)
-                } else {
-                    out(self.normalize(v[0].node, span), Unit::ONE, true)
-                }
-            }
-            "dot" | "cross" => {
-                if !self.want(&v[0], true, &args[0], name, cx)
-                    || !self.want(&v[1], true, &args[1], name, cx)
-                {
-                    return Val::Error;
-                }
-                let unit = v[0].unit.times(v[1].unit);
-                if name == "cross" {
-                    out(self.b.cross(v[0].node, v[1].node, span), unit, true)
-                } else {
-                    let m = self.b.binary(BinaryOp::Mul, v[0].node, v[1].node, span);
-                    out(self.b.sum_channels(m, span), unit, false)
-                }
-            }
-            "abs" | "sq" | "sqrt" => {
-                let (op, unit) = match name {
-                    "abs" => (UnaryOp::Abs, Some(v[0].unit)),
-                    "sq" => (UnaryOp::Square, Some(v[0].unit.pow(2))),
-                    _ => (UnaryOp::Sqrt, v[0].unit.sqrt()),
-                };
-                let Some(unit) = unit else {
-                    self.error(
-                        cx,
-                        crate::lang::codes::UNIT_MISMATCH,
-                        args[0].span,
-                        format!("`sqrt` of {} has no unit", v[0].unit),
-                    )
-                    .help("take square roots of squared quantities such as m²");
-                    return Val::Error;
-                };
-                out(self.b.unary(op, v[0].node, span), unit, v[0].vector)
-            }
-            "sin" | "cos" => {
-                if !self.want(&v[0], false, &args[0], name, cx) {
-                    return Val::Error;
-                }
-                if !v[0].unit.is_angle_like() {
-                    self.error(
-                        cx,
-                        crate::lang::codes::UNIT_MISMATCH,
-                        args[0].span,
-                        format!("`{name}` needs an angle, found {}", v[0].unit),
-                    )
-                    .help("write angles with `deg` or `rad`, e.g. `sin(30 deg)`");
-                    return Val::Error;
-                }
-                let op = if name == "sin" {
-                    UnaryOp::Sin
-                } else {
-                    UnaryOp::Cos
-                };
-                out(self.b.unary(op, v[0].node, span), Unit::ONE, false)
-            }
-            "min" | "max" | "atan2" => {
-                if v[0].vector != v[1].vector {
-                    self.error(
-                        cx,
-                        crate::lang::codes::TYPE_MISMATCH,
-                        span,
-                        format!("`{name}` of a scalar and a vector"),
-                    )
-                    .help("both arguments must be scalars, or both vectors");
-                    return Val::Error;
-                }
-                let Some(unit) = unify(self, &v[0], &v[1]) else {
-                    return Val::Error;
-                };
-                let (op, unit) = match name {
-                    "min" => (BinaryOp::Min, unit),
-                    "max" => (BinaryOp::Max, unit),
-                    _ => (BinaryOp::Atan2, Unit::RAD),
-                };
-                out(
-                    self.b.binary(op, v[0].node, v[1].node, span),
-                    unit,
-                    v[0].vector,
-                )
-            }
-            "clamp" => {
-                let Some(u1) = unify(self, &v[0], &v[1]) else {
-                    return Val::Error;
-                };
-                let Some(unit) = unify(self, &Num { unit: u1, ..v[0] }, &v[2]) else {
-                    return Val::Error;
-                };
-                if v[1].vector || v[2].vector {
-                    self.error(
-                        cx,
-                        crate::lang::codes::TYPE_MISMATCH,
-                        span,
-                        "`clamp` bounds must be scalars",
-                    )
-                    .help("e.g. `clamp(t, 0, 1)`");
-                    return Val::Error;
-                }
-                let lo = self.b.binary(BinaryOp::Max, v[0].node, v[1].node, span);
-                out(
-                    self.b.binary(BinaryOp::Min, lo, v[2].node, span),
-                    unit,
-                    v[0].vector,
-                )
-            }
-            "vec" => {
-                for (n, e) in v.iter().zip(args) {
-                    if !self.want(n, false, e, name, cx) {
-                        return Val::Error;
-                    }
-                }
-                let Some(u1) = unify(self, &v[0], &v[1]) else {
-                    return Val::Error;
-                };
-                let Some(unit) = unify(self, &Num { unit: u1, ..v[0] }, &v[2]) else {
-                    return Val::Error;
-                };
-                out(
-                    self.b.compose([v[0].node, v[1].node, v[2].node], span),
-                    unit,
-                    true,
-                )
-            }
-            _ => Val::Error,
-        }
     }
 }

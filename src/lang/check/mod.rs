@@ -10,6 +10,7 @@
 //! | `expr.rs` | expressions, names, members, lists, `@` |
 //! | `ops.rs` | operators: kinds and units |
 //! | `calls.rs` | builtin and user function calls |
+//! | `numeric.rs` | numeric builtins: vector maths, `abs`/`sqrt`/`sin`…, `min`/`max`, `clamp`, `vec` |
 //! | `time.rs` | time positions (`2s`, `50%`, `end - 1`) |
 //! | `builder.rs` | IR nodes: shapes, sharing, constant folding |
 //! | `advice.rs` | warnings on the IR: impossible, out-of-reach and jumping constraints |
@@ -24,6 +25,7 @@ mod expr;
 pub mod feasibility;
 mod geometry;
 mod header;
+mod numeric;
 mod ops;
 pub mod reach;
 mod stmt;
