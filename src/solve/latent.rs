@@ -135,20 +135,10 @@ impl LatentConfig {
     }
 }
 
-/// The DDIM (η = 0) chain from `z`: on an autodiff device with a frozen model it is
-/// differentiable with respect to `z`.
-pub fn ddim_chain(
-    den: &impl Denoiser,
-    schedule: &NoiseSchedule,
-    z: Tensor<3>,
-    cond: &Condition,
-) -> Tensor<3> {
-    ddim_chain_from(den, schedule, schedule.len(), z, cond, None)
-}
-
-/// [`ddim_chain`] over the steps `first − 1` down to 0 only (an edit starts part-way),
-/// with an edit's held frames and columns put into every x̂0.
-fn ddim_chain_from(
+/// The DDIM (η = 0) chain from `z` over the steps `first − 1` down to 0 (all of them, or
+/// an edit's part), with an edit's held frames and columns put into every x̂0. On an
+/// autodiff device with a frozen model it is differentiable with respect to `z`.
+fn ddim_chain(
     den: &impl Denoiser,
     schedule: &NoiseSchedule,
     first: usize,
@@ -382,7 +372,7 @@ impl<'a, 'c> Chain<'a, 'c> {
         let (dims, ad) = (self.ctx.dims(), &self.ad);
         let zt = Tensor::<3>::from_data(TensorData::new(z.to_vec(), dims), ad).require_grad();
         if !self.checkpoint {
-            let x = ddim_chain_from(
+            let x = ddim_chain(
                 &self.model,
                 &self.schedule,
                 self.first,
