@@ -100,6 +100,19 @@ pub fn body_facing(pose: &Pose64, frame: usize) -> Result<DQuat, FeatureError> {
     Ok(yaw_to_face_z(forward).inverse())
 }
 
+/// The bone from joint `j`'s parent to `j`, or an error naming it when it has no length.
+fn bone_vector(pose: &Pose64, j: usize, frame: usize) -> Result<DVec3, FeatureError> {
+    let bone = pose[j] - pose[PARENTS[j]];
+    if bone.length() < MIN_LENGTH {
+        return Err(FeatureError::ZeroBone {
+            frame,
+            joint: j,
+            name: JOINT_NAMES[j],
+        });
+    }
+    Ok(bone)
+}
+
 /// Global rotation of every bone of one pose (index = child joint; `[0]` is the identity):
 /// the minimal rotation from the rest direction to the current direction.
 ///
@@ -107,14 +120,7 @@ pub fn body_facing(pose: &Pose64, frame: usize) -> Result<DQuat, FeatureError> {
 pub fn bone_rotations(pose: &Pose64, frame: usize) -> Result<[DQuat; NUM_JOINTS], FeatureError> {
     let mut g = [DQuat::IDENTITY; NUM_JOINTS];
     for j in 1..NUM_JOINTS {
-        let bone = pose[j] - pose[PARENTS[j]];
-        if bone.length() < MIN_LENGTH {
-            return Err(FeatureError::ZeroBone {
-                frame,
-                joint: j,
-                name: JOINT_NAMES[j],
-            });
-        }
+        let bone = bone_vector(pose, j, frame)?;
         g[j] = rotation_between(DVec3::from(RAW_OFFSETS[j].map(f64::from)), bone);
     }
     Ok(g)
@@ -136,14 +142,7 @@ pub fn chained_bone_rotations(
     g[0] = root;
     // Parents come before their children in HumanML3D's joint order.
     for j in 1..NUM_JOINTS {
-        let bone = pose[j] - pose[PARENTS[j]];
-        if bone.length() < MIN_LENGTH {
-            return Err(FeatureError::ZeroBone {
-                frame,
-                joint: j,
-                name: JOINT_NAMES[j],
-            });
-        }
+        let bone = bone_vector(pose, j, frame)?;
         let base = g[PARENTS[j]];
         let rest = base * DVec3::from(RAW_OFFSETS[j].map(f64::from));
         g[j] = rotation_between(rest, bone) * base;
