@@ -74,15 +74,22 @@ fn request(solver: Solver, e: Edit) -> SolveRequest {
 }
 
 fn solve_ok(req: &SolveRequest) -> SolveResult {
+    solve_reporting(req).0
+}
+
+/// The solve and its progress reports, `(done, total)` each.
+fn solve_reporting(req: &SolveRequest) -> (SolveResult, Vec<(usize, usize)>) {
     let bundle = tiny_bundle();
-    solve(
+    let mut reports = Vec::new();
+    let r = solve(
         &Prior::from_bundle(&bundle),
         req,
         &wrist_up,
         &Device::flex(),
-        |_| {},
+        |p| reports.push((p.done, p.total)),
     )
-    .unwrap_or_else(|e| panic!("{}: {e}", req.solver.name()))
+    .unwrap_or_else(|e| panic!("{}: {e}", req.solver.name()));
+    (r, reports)
 }
 
 /// Largest difference between two feature rows ranges (de-normalised).
@@ -181,21 +188,12 @@ fn host_error(flat: &[f32]) -> f32 {
 
 #[test]
 fn strength_sets_how_much_of_the_chain_runs() {
-    let bundle = tiny_bundle();
     for (s, steps) in [(0.0, 0), (0.25, 10), (0.5, 20), (1.0, 40)] {
         let req = request(
             Solver::plain(crate::model::sampler::SamplerKind::Ddpm(40)),
             edit(s, Vec::new()),
         );
-        let mut reports = Vec::new();
-        solve(
-            &Prior::from_bundle(&bundle),
-            &req,
-            &wrist_up,
-            &Device::flex(),
-            |p| reports.push((p.done, p.total)),
-        )
-        .unwrap();
+        let (_, reports) = solve_reporting(&req);
         assert_eq!(reports.len(), steps, "strength {s}");
         assert!(reports.iter().all(|&(_, total)| total == steps));
     }
@@ -376,16 +374,7 @@ fn a_resampled_edit_reports_every_step_and_is_deterministic() {
         ..edit(1.0, hold_weights(N, &[0..4, N - 4..N], 2))
     };
     let req = request(guide(), e);
-    let bundle = tiny_bundle();
-    let mut reports = Vec::new();
-    let a = solve(
-        &Prior::from_bundle(&bundle),
-        &req,
-        &wrist_up,
-        &Device::flex(),
-        |p| reports.push((p.done, p.total)),
-    )
-    .unwrap();
+    let (a, reports) = solve_reporting(&req);
     let total = 40 + 2 * 30;
     assert_eq!(reports.len(), total);
     assert_eq!(reports.last(), Some(&(total, total)));

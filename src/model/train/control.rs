@@ -397,19 +397,18 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_control_net_trains_on_a_frozen_base_and_resumes() {
-        let data = synthetic_dataset();
+    /// A tiny base model trained `steps` steps on `data`; its bundle is `<dir>/bundle`.
+    fn train_tiny_base(data: &Dataset, steps: usize, warmup_steps: usize) -> tempfile::TempDir {
         let base_run = tempfile::tempdir().unwrap();
         TrainRun {
-            data: &data,
+            data,
             config: TrainConfig {
                 model: tiny(),
                 batch_size: 2,
                 crop_frames: 8,
-                warmup_steps: 1,
-                checkpoint_every: 5,
-                steps: 5,
+                warmup_steps,
+                checkpoint_every: steps,
+                steps,
                 ..TrainConfig::default()
             },
             out: base_run.path().to_path_buf(),
@@ -422,6 +421,13 @@ mod tests {
         }
         .run(&|_, _, _| {})
         .unwrap();
+        base_run
+    }
+
+    #[test]
+    fn a_control_net_trains_on_a_frozen_base_and_resumes() {
+        let data = synthetic_dataset();
+        let base_run = train_tiny_base(&data, 5, 1);
         let base = base_run.path().join("bundle");
         let before = std::fs::read(base.join("model.safetensors")).unwrap();
         let out = tempfile::tempdir().unwrap();
@@ -465,27 +471,7 @@ mod tests {
     #[test]
     fn a_control_net_is_refused_data_with_other_statistics() {
         let mut data = synthetic_dataset();
-        let base_run = tempfile::tempdir().unwrap();
-        TrainRun {
-            data: &data,
-            config: TrainConfig {
-                model: tiny(),
-                batch_size: 2,
-                crop_frames: 8,
-                checkpoint_every: 2,
-                steps: 2,
-                ..TrainConfig::default()
-            },
-            out: base_run.path().to_path_buf(),
-            max_steps_now: None,
-            interrupt: Default::default(),
-            init_from: None,
-            device: Device::flex(),
-            after_checkpoint: None,
-            text_encoder: None,
-        }
-        .run(&|_, _, _| {})
-        .unwrap();
+        let base_run = train_tiny_base(&data, 2, TrainConfig::default().warmup_steps);
         data.std[5] = 2.0;
         let out = tempfile::tempdir().unwrap();
         let err = ControlTrainRun {
