@@ -34,6 +34,10 @@ pub struct ActionBenchArgs {
     /// Model bundle (default: the shipped model).
     #[arg(long)]
     model: Option<PathBuf>,
+    /// Generate every prompt this long (default: each as long as `mprog gen` makes it:
+    /// the model's length prior, the walk 6 s).
+    #[arg(long)]
+    seconds: Option<f32>,
 }
 
 fn bench_actions(args: ActionBenchArgs) -> Result<()> {
@@ -44,9 +48,19 @@ fn bench_actions(args: ActionBenchArgs) -> Result<()> {
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot load the model {}", dir.display()))?;
-    let rows = mprog::metrics::actions::measure_actions(&bundle, &device).into_diagnostic()?;
+    if let Some(s) = args.seconds
+        && !(s.is_finite() && s > 0.0)
+    {
+        miette::bail!("--seconds must be a positive number of seconds, got {s}");
+    }
+    let rows = mprog::metrics::actions::measure_actions(&bundle, &device, args.seconds)
+        .into_diagnostic()?;
+    let length = match args.seconds {
+        Some(s) => format!("{s} s"),
+        None => "each prompt as long as `gen` makes it".to_string(),
+    };
     println!(
-        "model {} ({}): 6 s, DDIM 50, guidance 2.5, no cleanup; heights above the motion's lowest foot joint\n",
+        "model {} ({}): {length}, DDIM 50, guidance 2.5, no cleanup; heights above the motion's lowest foot joint\n",
         bundle.manifest.weights_id,
         dir.display()
     );

@@ -21,9 +21,10 @@ pub struct GenArgs {
     /// What the person does.
     #[arg(long)]
     text: String,
-    /// Length in seconds (20 fps).
-    #[arg(long, default_value_t = 6.0, conflicts_with = "frames")]
-    seconds: f32,
+    /// Length in seconds (20 fps). Default: as long as the training clips of the nearest
+    /// known caption (sentence-encoder models), else 6 s.
+    #[arg(long, conflicts_with = "frames")]
+    seconds: Option<f32>,
     /// Length in frames (instead of --seconds).
     #[arg(long)]
     frames: Option<usize>,
@@ -60,6 +61,21 @@ pub struct GenArgs {
     export: super::export::ExportArgs,
 }
 
+/// Length when neither the user nor the model's length prior gives one (6 s).
+const DEFAULT_FRAMES: usize = 120;
+
+/// `--seconds` in frames at 20 fps; refused when not a positive finite number.
+fn seconds_to_frames(seconds: f32) -> Result<usize> {
+    if seconds.is_finite() && seconds > 0.0 {
+        Ok(((seconds * 20.0).round() as usize).max(1))
+    } else {
+        Err(miette::miette!(
+            help = "give a length such as --seconds 4",
+            "--seconds must be a positive number of seconds, got {seconds}: the motion would have no frames"
+        ))
+    }
+}
+
 /// Parses `--sampler`/`--steps`.
 pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
     match name {
@@ -82,9 +98,25 @@ pub fn run(args: GenArgs) -> Result<()> {
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
-    let frames = args
-        .frames
-        .unwrap_or((args.seconds * 20.0).round() as usize);
+    let frames = match (args.frames, args.seconds) {
+        (Some(f), _) => f,
+        (None, Some(s)) => seconds_to_frames(s)?,
+        (None, None) => match bundle
+            .text
+            .natural_frames(&args.text, bundle.config.max_frames)
+        {
+            Some((frames, nearest)) => {
+                eprintln!(
+                    "length {:.1} s: the typical length of \"{}\" in the training data (cosine {:.2}); --seconds sets it",
+                    frames as f32 / 20.0,
+                    nearest.caption,
+                    nearest.cosine
+                );
+                frames
+            }
+            None => DEFAULT_FRAMES,
+        },
+    };
     let sampler = sampler_kind(&args.sampler, args.steps)?;
     let req = GenerateRequest {
         prompts: vec![args.text.clone(); args.count.max(1)],

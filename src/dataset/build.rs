@@ -15,8 +15,9 @@ use super::stats::feature_stats;
 use super::store::{
     ClipInfo, DATASET_VERSION, DatasetIndex, FEATURE_DIM, Split, SplitStats, write_f32_npy,
 };
+use super::takes::{Unit, plan_units, take_name};
 use crate::features::{ExtractOptions, extract, recover_from_ric};
-use crate::formats::bvh::{BvhImport, BvhImportOptions, import_bvh};
+use crate::formats::bvh::{BvhImport, BvhImportOptions, import_bvh, import_parsed};
 use crate::motion::Motion;
 use crate::skeleton::{FPS, NUM_JOINTS, mirror_joint};
 use rayon::prelude::*;
@@ -190,11 +191,13 @@ fn to_clip(
     })
 }
 
-/// A converted file: its clips, family and rig.
+/// A converted file (or joined take, see [`super::takes`]): its clips, family and rig.
 struct FileResult {
     family: &'static str,
     rig: Option<&'static str>,
     clips: Result<Vec<Converted>, String>,
+    /// Files read into it.
+    files: usize,
 }
 
 /// Imports one motion file by its extension (`.amc` with the `.asf` beside it).
@@ -210,8 +213,10 @@ fn import_file(path: &Path) -> Result<BvhImport, String> {
     }
 }
 
-/// Converts one file into its clip (and mirrored clip).
-fn convert_file(path: &Path, root: &Path, ctx: &LabelContext, opts: &BuildOptions) -> FileResult {
+/// Converts one file, or one take joined from cuts, into its clip (and mirrored clip).
+/// A take is captioned by its first cut's name and split by its first cut's path.
+fn convert_unit(unit: Unit, root: &Path, ctx: &LabelContext, opts: &BuildOptions) -> FileResult {
+    let path = unit.first();
     let source = path
         .strip_prefix(root)
         .unwrap_or(path)
@@ -221,16 +226,40 @@ fn convert_file(path: &Path, root: &Path, ctx: &LabelContext, opts: &BuildOption
         .file_stem()
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_default();
+    let files = unit.file_count();
     let text = clip_text(&stem, ctx);
     let family = text.as_ref().map_or("?", |t| t.family);
-    let (rig, clips) = match text.and_then(|t| import_file(path).map(|i| (t, i))) {
+    let (name, import) = match unit {
+        Unit::File(path) => (stem.clone(), import_file(&path)),
+        Unit::Take { files, bvh } => {
+            let last = files
+                .last()
+                .and_then(|p| p.file_stem())
+                .map_or_else(|| stem.clone(), |s| s.to_string_lossy().to_string());
+            let number = last
+                .split('_')
+                .nth(3)
+                .and_then(|n| n.parse().ok())
+                .unwrap_or(0);
+            let origin = format!("{} (+{} cuts)", files[0].display(), files.len() - 1);
+            let import = import_parsed(&origin, bvh, &BvhImportOptions::default())
+                .map_err(|e| e.to_string());
+            (take_name(&stem, number), import)
+        }
+    };
+    let (rig, clips) = match text.and_then(|t| import.map(|i| (t, i))) {
         Err(e) => (None, Err(e)),
         Ok((text, import)) => (
             Some(import.joint_map.rig),
-            clips_of(&import.motion, &stem, &source, &text, opts),
+            clips_of(&import.motion, &name, &source, &text, opts),
         ),
     };
-    FileResult { family, rig, clips }
+    FileResult {
+        family,
+        rig,
+        clips,
+        files,
+    }
 }
 
 fn clips_of(
@@ -323,7 +352,7 @@ fn rig_stats(results: &[(PathBuf, FileResult)]) -> Vec<RigStats> {
             });
         match &r.clips {
             Ok(clips) => {
-                s.read += 1;
+                s.read += r.files;
                 let frames: usize = clips
                     .iter()
                     .filter(|c| !c.info.mirrored)
@@ -332,7 +361,7 @@ fn rig_stats(results: &[(PathBuf, FileResult)]) -> Vec<RigStats> {
                 s.minutes += frames as f64 / FPS as f64 / 60.0;
             }
             Err(reason) => {
-                s.skipped += 1;
+                s.skipped += r.files;
                 // Reasons name the file; count them without it.
                 let shown = path.display().to_string();
                 let short = reason.replace(&shown, "<file>");
@@ -364,12 +393,13 @@ pub fn build_dataset_report(
             Err(e) => notes.push((csv.display().to_string(), e)),
         }
     }
-    let mut results: Vec<(PathBuf, FileResult)> = files
-        .par_iter()
-        .map(|p| {
-            let r = convert_file(p, bvh_dir, &ctx, opts);
-            tick(p);
-            (p.clone(), r)
+    let mut results: Vec<(PathBuf, FileResult)> = plan_units(&files)
+        .into_par_iter()
+        .map(|unit| {
+            let paths = unit.files().to_vec();
+            let r = convert_unit(unit, bvh_dir, &ctx, opts);
+            paths.iter().for_each(|p| tick(p));
+            (paths[0].clone(), r)
         })
         .collect();
     unique_names(&mut results);

@@ -35,10 +35,11 @@ pub fn hdm05_captions(class: &str) -> Vec<String> {
             "gets down and lies on the floor",
             "goes from standing to lying on the ground",
         ],
+        // Each hop travels about a metre: standing long jumps, not jumps in place.
         "hopBothLegs1hops" | "hopBothLegs2hops" | "hopBothLegs3hops" => &[
-            "jumps up and down in place",
-            "hops on both feet",
-            "jumps with both legs",
+            "jumps forward with both feet together",
+            "hops forward on both feet",
+            "does standing long jumps forward",
         ],
         "grabHighR" => &[
             "reaches up high with the right hand and grabs something",

@@ -10,5 +10,6 @@ pub mod labels;
 pub mod split;
 pub mod stats;
 pub mod store;
+pub mod takes;
 
 pub use store::{ClipInfo, Dataset, DatasetError, DatasetIndex, FEATURE_DIM, Split, SplitStats};

@@ -1,6 +1,10 @@
 //! What the motion prior does with named actions (issue 28's "done when"): each prompt is
-//! generated with seeds 1 and 2 (6 s, DDIM 50, guidance 2.5, no cleanup) and one number is
-//! read off the motion against a threshold. `mprog bench actions` prints the table.
+//! generated with seeds 1 and 2 (DDIM 50, guidance 2.5, no cleanup) and one number is read
+//! off the motion against a threshold. `mprog bench actions` prints the table.
+//!
+//! Each prompt is as long as `mprog gen` makes it by default: the model's length prior
+//! ([`crate::model::lengths`]; 6 s for a model without one), except the walk, which the
+//! issue measures in 6 s. `--seconds` pins every prompt to one length.
 //!
 //! Heights are above the motion's own floor (its lowest ankle or toe), so a model that
 //! floats or sinks a little is not rewarded or punished for it.
@@ -91,6 +95,8 @@ pub struct Case {
     pub value: fn(&Track) -> f32,
     /// Whether a value meets the threshold.
     pub pass: fn(f32) -> bool,
+    /// A fixed length in seconds (None: the model's length prior).
+    pub seconds: Option<f32>,
 }
 
 /// The prompts and what each must do.
@@ -100,48 +106,56 @@ pub const CASES: &[Case] = &[
         what: "both feet off the ground at once (m, ≥ 0.15)",
         value: Track::both_feet_up,
         pass: |v| v >= 0.15,
+        seconds: None,
     },
     Case {
         prompt: "a man kicks forward with his right leg",
         what: "highest ankle (m, ≥ 0.6)",
         value: |t| t.max_of(&[L_ANKLE, R_ANKLE]),
         pass: |v| v >= 0.6,
+        seconds: None,
     },
     Case {
         prompt: "a person crouches down low and stands back up",
         what: "lowest head (m, ≤ 1.15)",
         value: |t| t.min_of(&[HEAD]),
         pass: |v| v <= 1.15,
+        seconds: None,
     },
     Case {
         prompt: "a person picks something up from the floor",
         what: "lowest wrist (m, ≤ 0.25)",
         value: |t| t.min_of(&[L_WRIST, R_WRIST]),
         pass: |v| v <= 0.25,
+        seconds: None,
     },
     Case {
         prompt: "a person lies down on the floor",
         what: "pelvis at the end (m, ≤ 0.3)",
         value: |t| t.y[t.y.len() - 1][PELVIS],
         pass: |v| v <= 0.3,
+        seconds: None,
     },
     Case {
         prompt: "a person runs forward",
         what: "speed (m/s, ≥ 2.2)",
         value: Track::speed,
         pass: |v| v >= 2.2,
+        seconds: None,
     },
     Case {
         prompt: "a person walks forward",
         what: "speed (m/s, ≥ 0.34: 2 m in 6 s)",
         value: Track::speed,
         pass: |v| v >= 2.0 / 6.0,
+        seconds: Some(6.0),
     },
     Case {
         prompt: "a person strolls",
         what: "speed (m/s, ≥ 0.34, like a walk)",
         value: Track::speed,
         pass: |v| v >= 2.0 / 6.0,
+        seconds: None,
     },
     Case {
         prompt: "a person raises both hands",
@@ -152,6 +166,7 @@ pub const CASES: &[Case] = &[
                 .fold(f32::NEG_INFINITY, f32::max)
         },
         pass: |v| v > 0.0,
+        seconds: None,
     },
     Case {
         prompt: "a person elevates both arms",
@@ -162,6 +177,7 @@ pub const CASES: &[Case] = &[
                 .fold(f32::NEG_INFINITY, f32::max)
         },
         pass: |v| v > 0.0,
+        seconds: None,
     },
 ];
 
@@ -171,6 +187,8 @@ pub struct ActionRow {
     pub case: &'static Case,
     /// Value per seed.
     pub values: [f32; 2],
+    /// Length generated, in frames.
+    pub frames: usize,
 }
 
 impl ActionRow {
@@ -180,19 +198,28 @@ impl ActionRow {
     }
 }
 
-/// Generates every case with seeds 1 and 2 and measures it.
+/// Generates every case with seeds 1 and 2 and measures it; `seconds` pins every case's
+/// length (else each has its own, see the module's notes).
 pub fn measure_actions(
     bundle: &ModelBundle,
     device: &Device,
+    seconds: Option<f32>,
 ) -> Result<Vec<ActionRow>, GenerateError> {
     CASES
         .iter()
         .map(|case| {
+            let frames = match seconds.or(case.seconds) {
+                Some(s) => (s * 20.0).round().max(1.0) as usize,
+                None => bundle
+                    .text
+                    .natural_frames(case.prompt, bundle.config.max_frames)
+                    .map_or(120, |(frames, _)| frames),
+            };
             let mut values = [0.0; 2];
             for (i, seed) in [1u64, 2].into_iter().enumerate() {
                 let req = GenerateRequest {
                     prompts: vec![case.prompt.to_string()],
-                    frames: 120,
+                    frames,
                     seed,
                     sampler: SamplerKind::Ddim(50),
                     guidance_scale: 2.5,
@@ -201,20 +228,26 @@ pub fn measure_actions(
                 let out = generate(bundle, &req, device, |_, _| {})?;
                 values[i] = (case.value)(&track(&out.motions[0]));
             }
-            Ok(ActionRow { case, values })
+            Ok(ActionRow {
+                case,
+                values,
+                frames,
+            })
         })
         .collect()
 }
 
 /// The rows as a Markdown table (✗ marks a value that misses its threshold).
 pub fn actions_table(rows: &[ActionRow]) -> String {
-    let mut s =
-        String::from("| prompt | measure | seed 1 | seed 2 |\n| --- | --- | ---: | ---: |\n");
+    let mut s = String::from(
+        "| prompt | length (s) | measure | seed 1 | seed 2 |\n| --- | ---: | --- | ---: | ---: |\n",
+    );
     for row in rows {
         let cell = |v: f32| format!("{v:.2}{}", if (row.case.pass)(v) { "" } else { " ✗" });
         s.push_str(&format!(
-            "| {} | {} | {} | {} |\n",
+            "| {} | {:.1} | {} | {} | {} |\n",
             row.case.prompt,
+            row.frames as f32 / 20.0,
             row.case.what,
             cell(row.values[0]),
             cell(row.values[1])

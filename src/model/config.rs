@@ -132,6 +132,11 @@ pub struct TrainConfig {
     /// walking are otherwise seen too rarely to be learned.
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub source_weights: std::collections::BTreeMap<String, f64>,
+    /// Average the x0 MSE per clip, then over the batch (MDM's `masked_l2`), instead of
+    /// over every valid frame of the batch: with frame weighting a 13-frame hop padded to a
+    /// 120-frame batch counts a ninth of a walk, whatever `source_weights` says.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub loss_per_clip: bool,
     /// Seed of the data order and noise.
     pub seed: u64,
 }
@@ -155,6 +160,7 @@ impl Default for TrainConfig {
             root_loss: 0.0,
             word_drop: 0.0,
             source_weights: Default::default(),
+            loss_per_clip: false,
             seed: 1,
         }
     }

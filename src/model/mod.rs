@@ -9,6 +9,7 @@ pub mod control;
 pub mod denoiser;
 pub mod ema;
 pub mod generate;
+pub mod lengths;
 pub mod mirror_average;
 pub mod noise;
 pub mod prompt;

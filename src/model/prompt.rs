@@ -3,6 +3,7 @@
 //! encoder. [`PromptEncoder`] is the bundle's side (prompts → [`TextBatch`], and what to
 //! tell the user about a prompt); [`TextBatch`] is what travels in a `DenoiserInput`.
 
+use super::lengths::{CaptionLengths, MIN_FRAMES};
 use super::sentence::{CaptionIndex, FAR_COSINE, Nearest, SentenceEncoder};
 use super::text::{TokenBatch, Vocabulary};
 use burn::prelude::*;
@@ -112,6 +113,8 @@ pub struct SentencePrompts {
     pub encoder: Arc<SentenceEncoder>,
     /// The training captions, embedded (for "nearest known caption").
     pub captions: CaptionIndex,
+    /// Median clip length of each training caption (empty for older bundles).
+    pub lengths: CaptionLengths,
 }
 
 /// Turns prompts into a model's text condition.
@@ -166,6 +169,27 @@ impl PromptEncoder {
             PromptEncoder::Words(_) => None,
             PromptEncoder::Sentences(s) => s.captions.nearest(&s.encoder, &[prompt]).pop(),
         }
+    }
+
+    /// The length prior's proposal for `prompt` ([`super::lengths`]): the median length of
+    /// the clips of the nearest training caption that has one, clamped to
+    /// `[MIN_FRAMES, max_frames]`, with that caption. None for a bag-of-words model or a
+    /// bundle without lengths.
+    pub fn natural_frames(&self, prompt: &str, max_frames: usize) -> Option<(usize, Nearest)> {
+        let PromptEncoder::Sentences(s) = self else {
+            return None;
+        };
+        if s.lengths.is_empty() {
+            return None;
+        }
+        let nearest = s
+            .captions
+            .nearest_among(&s.encoder, prompt, &|c| s.lengths.get(c).is_some())?;
+        let frames = s.lengths.get(&nearest.caption)?;
+        Some((
+            frames.clamp(MIN_FRAMES.min(max_frames), max_frames),
+            nearest,
+        ))
     }
 
     /// What the model makes of a prompt, as lines for the user: for a bag-of-words model

@@ -147,3 +147,41 @@ fn far_prompts_are_reported_with_the_nearest_caption() {
     assert!(far[0].contains("nearest known: \"a person"), "{far:?}");
     assert!(bundle.text.unknown_words("someone moonwalks").is_empty());
 }
+
+#[test]
+fn the_length_prior_gives_the_nearest_training_captions_length() {
+    let dev = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    train(dir.path(), sentence_tiny(), None, 1e-3, 5);
+    let bundle_dir = dir.path().join("bundle");
+    let bundle = ModelBundle::load(&bundle_dir, &dev).unwrap();
+    // Only the training clip (24 frames, "a person walks forward") has a length; the
+    // validation clip's caption ("a person waves") is never proposed.
+    let (frames, nearest) = bundle
+        .text
+        .natural_frames("someone strolls ahead", 196)
+        .unwrap();
+    assert_eq!(
+        (frames, nearest.caption.as_str()),
+        (24, "a person walks forward")
+    );
+    let (_, nearest) = bundle.text.natural_frames("a person waves", 196).unwrap();
+    assert_eq!(nearest.caption, "a person walks forward");
+    assert_eq!(
+        bundle.text.natural_frames("a person walks", 10).unwrap().0,
+        10
+    );
+    // A bundle without lengths (older ones) proposes none; a broken file is named.
+    let lengths = bundle_dir.join("lengths.json");
+    std::fs::write(&lengths, "{\"a person walks forward\": 0}").unwrap();
+    let err = ModelBundle::load(&bundle_dir, &dev)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("lengths.json") && err.contains("length 0"),
+        "{err}"
+    );
+    std::fs::remove_file(&lengths).unwrap();
+    let old = ModelBundle::load(&bundle_dir, &dev).unwrap();
+    assert!(old.text.natural_frames("a person walks", 196).is_none());
+}

@@ -7,6 +7,7 @@
 //! <dir>/vocab.json         Vocabulary (bag-of-words models)
 //! <dir>/captions.safetensors  training captions, embedded (sentence-encoder models)
 //! <dir>/actions.json       what the training clips show, with clip counts (optional)
+//! <dir>/lengths.json       median clip length per training caption (optional)
 //! <dir>/mean.npy, std.npy  [263] normalisation statistics
 //! <dir>/model.safetensors  denoiser weights
 //! ```
@@ -17,6 +18,7 @@
 
 use super::config::{ModelConfig, TextEncoderKind};
 use super::denoiser::Mdm;
+use super::lengths::CaptionLengths;
 use super::prompt::{PromptEncoder, SentencePrompts};
 use super::sentence::{CaptionIndex, SentenceEncoder, default_encoder_dir};
 use super::text::Vocabulary;
@@ -271,6 +273,7 @@ pub fn save_bundle_parts(
         PromptEncoder::Sentences(s) => {
             let p = dir.join("captions.safetensors");
             s.captions.save(&p).map_err(|e| write_err(&p, e))?;
+            s.lengths.save(dir)?;
         }
     }
     for (name, v) in [("mean.npy", mean), ("std.npy", std)] {
@@ -330,6 +333,7 @@ fn load_prompt_encoder(
     Ok(PromptEncoder::Sentences(Box::new(SentencePrompts {
         encoder: std::sync::Arc::new(encoder),
         captions,
+        lengths: CaptionLengths::load(dir)?,
     })))
 }
 

@@ -86,6 +86,33 @@ impl CaptionIndex {
         }
     }
 
+    /// Nearest caption of `prompt` among those `keep` accepts; None when it accepts none.
+    pub fn nearest_among(
+        &self,
+        encoder: &SentenceEncoder,
+        prompt: &str,
+        keep: &dyn Fn(&str) -> bool,
+    ) -> Option<Nearest> {
+        if self.captions.is_empty() {
+            return None;
+        }
+        let sims = encoder
+            .encode(&[prompt])
+            .matmul(self.embeddings.clone().transpose())
+            .into_data()
+            .try_to_vec_as::<f32>()
+            .expect("float tensors read back as f32");
+        self.captions
+            .iter()
+            .zip(sims)
+            .filter(|(c, _)| keep(c))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(caption, cosine)| Nearest {
+                caption: caption.clone(),
+                cosine,
+            })
+    }
+
     /// Writes the index as SafeTensors (f16).
     pub fn save(&self, path: &Path) -> Result<(), SentenceError> {
         let [n, dim] = self.embeddings.dims();

@@ -178,7 +178,7 @@ impl ControlTrainRun<'_> {
         let text = match &bundle.text {
             PromptEncoder::Words(v) => TrainText::Words(v.clone()),
             PromptEncoder::Sentences(s) => {
-                TrainText::sentences(s.encoder.clone(), s.captions.clone())
+                TrainText::sentences(s.encoder.clone(), s.captions.clone(), s.lengths.clone())
             }
         };
         let mut ck = self.load_or_init(&base, &device)?;

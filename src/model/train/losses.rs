@@ -75,6 +75,16 @@ pub fn masked_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1>
     err.sum() / (valid.sum() * f)
 }
 
+/// Masked x0 MSE averaged per sample, then over the batch (MDM's `masked_l2`): each clip
+/// counts the same, however many of its frames are padding.
+pub fn per_clip_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+    let [b, _, f] = pred.dims();
+    let err = (pred - x0).powi_scalar(2) * valid.clone();
+    let per_clip = err.sum_dim(2).sum_dim(1).reshape([b]);
+    let frames = valid.sum_dim(1).reshape([b]).clamp_min(1.0);
+    (per_clip / (frames * f as f32)).mean()
+}
+
 /// Masked x0 MSE of the root columns alone (yaw velocity, XZ velocity, height).
 pub fn root_mse(pred: Tensor<3>, x0: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
     let root = ROOT_YAW_VEL.start..ROOT_Y.end;
@@ -187,6 +197,8 @@ pub struct GeometricLosses {
     pub velocity: Option<VelocityLoss>,
     /// Weight of the extra root-column MSE (None when 0).
     pub root: Option<f32>,
+    /// The x0 MSE per clip ([`per_clip_mse`]) rather than per frame.
+    pub per_clip: bool,
 }
 
 impl GeometricLosses {
@@ -196,6 +208,7 @@ impl GeometricLosses {
             foot: FootLoss::new(cfg.foot_loss, mean, std, device),
             velocity: VelocityLoss::new(cfg.velocity_loss, std, device),
             root: (cfg.root_loss > 0.0).then_some(cfg.root_loss as f32),
+            per_clip: cfg.loss_per_clip,
         }
     }
 }
@@ -212,7 +225,11 @@ pub(super) fn batch_loss(
     let (mut input, x0, valid) = to_device(batch, text, device);
     input.x_t = q_sample(schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
     let pred = model.predict_x0(&input);
-    let mut loss = masked_mse(pred.clone(), x0.clone(), valid.clone());
+    let mut loss = if geometric.per_clip {
+        per_clip_mse(pred.clone(), x0.clone(), valid.clone())
+    } else {
+        masked_mse(pred.clone(), x0.clone(), valid.clone())
+    };
     if let Some(f) = &geometric.foot {
         loss = loss
             + f.term(pred.clone(), x0.clone(), valid.clone())
@@ -227,4 +244,28 @@ pub(super) fn batch_loss(
         loss = loss + root_mse(pred, x0, valid).mul_scalar(w);
     }
     loss
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn per_clip_mse_weighs_clips_not_frames() {
+        let device = Device::default();
+        // Clip 0: 1 valid frame with squared error 4; clip 1: 3 valid frames with error 0.
+        let pred = Tensor::<3>::from_data(
+            TensorData::new(vec![2.0f32, 0., 0., 0., 0., 0., 0., 0.], [2, 4, 1]),
+            &device,
+        );
+        let x0 = Tensor::<3>::zeros([2, 4, 1], &device);
+        let valid = Tensor::<3>::from_data(
+            TensorData::new(vec![1.0f32, 0., 0., 0., 1., 1., 1., 0.], [2, 4, 1]),
+            &device,
+        );
+        let per_frame = masked_mse(pred.clone(), x0.clone(), valid.clone()).into_scalar::<f32>();
+        let per_clip = per_clip_mse(pred, x0, valid).into_scalar::<f32>();
+        assert!((per_frame - 1.0).abs() < 1e-6, "{per_frame}"); // 4 / 4 frames
+        assert!((per_clip - 2.0).abs() < 1e-6, "{per_clip}"); // (4/1 + 0/3) / 2
+    }
 }

@@ -6,6 +6,7 @@ use super::{TrainError, TrainRun, file_err};
 use crate::dataset::{Dataset, Split};
 use crate::fsutil::write_bytes_atomic;
 use crate::model::config::TextEncoderKind;
+use crate::model::lengths::CaptionLengths;
 use crate::model::prompt::{PromptEncoder, SentenceBatch, SentencePrompts, TextBatch};
 use crate::model::sentence::{CaptionIndex, SentenceEncoder, default_encoder_dir};
 use crate::model::text::{TokenBatch, Vocabulary};
@@ -30,7 +31,11 @@ pub enum TrainText {
 
 impl TrainText {
     /// A sentence-encoder run's text side.
-    pub fn sentences(encoder: Arc<SentenceEncoder>, captions: CaptionIndex) -> TrainText {
+    pub fn sentences(
+        encoder: Arc<SentenceEncoder>,
+        captions: CaptionIndex,
+        lengths: CaptionLengths,
+    ) -> TrainText {
         let rows = captions
             .captions()
             .iter()
@@ -38,7 +43,11 @@ impl TrainText {
             .map(|(i, c)| (c.clone(), i))
             .collect();
         TrainText::Sentences {
-            prompts: Box::new(SentencePrompts { encoder, captions }),
+            prompts: Box::new(SentencePrompts {
+                encoder,
+                captions,
+                lengths,
+            }),
             rows,
         }
     }
@@ -143,7 +152,11 @@ impl TrainRun<'_> {
                 index
             }
         };
-        Ok(TrainText::sentences(Arc::new(encoder), index))
+        Ok(TrainText::sentences(
+            Arc::new(encoder),
+            index,
+            CaptionLengths::of_dataset(self.data),
+        ))
     }
 
     /// The run's vocabulary: read back when resuming, else built from the captions and saved.
