@@ -107,7 +107,7 @@ pub fn run(args: GenArgs) -> Result<()> {
         {
             Some((frames, nearest)) => {
                 eprintln!(
-                    "length {:.1} s: the typical length of \"{}\" in the training data (cosine {:.2}); --seconds sets it",
+                    "length {:.1} s: the median length of the training clips captioned nearest to the prompt (nearest: \"{}\", cosine {:.2}); --seconds sets it",
                     frames as f32 / 20.0,
                     nearest.caption,
                     nearest.cosine

@@ -3,7 +3,7 @@
 //! encoder. [`PromptEncoder`] is the bundle's side (prompts → [`TextBatch`], and what to
 //! tell the user about a prompt); [`TextBatch`] is what travels in a `DenoiserInput`.
 
-use super::lengths::{CaptionLengths, MIN_FRAMES};
+use super::lengths::CaptionLengths;
 use super::sentence::{CaptionIndex, FAR_COSINE, Nearest, SentenceEncoder};
 use super::text::{TokenBatch, Vocabulary};
 use burn::prelude::*;
@@ -171,10 +171,8 @@ impl PromptEncoder {
         }
     }
 
-    /// The length prior's proposal for `prompt` ([`super::lengths`]): the median length of
-    /// the clips of the nearest training caption that has one, clamped to
-    /// `[MIN_FRAMES, max_frames]`, with that caption. None for a bag-of-words model or a
-    /// bundle without lengths.
+    /// The length prior's proposal for `prompt` ([`super::lengths`]) in frames, with the
+    /// nearest training caption. None for a bag-of-words model or a bundle without lengths.
     pub fn natural_frames(&self, prompt: &str, max_frames: usize) -> Option<(usize, Nearest)> {
         let PromptEncoder::Sentences(s) = self else {
             return None;
@@ -182,14 +180,8 @@ impl PromptEncoder {
         if s.lengths.is_empty() {
             return None;
         }
-        let nearest = s
-            .captions
-            .nearest_among(&s.encoder, prompt, &|c| s.lengths.get(c).is_some())?;
-        let frames = s.lengths.get(&nearest.caption)?;
-        Some((
-            frames.clamp(MIN_FRAMES.min(max_frames), max_frames),
-            nearest,
-        ))
+        s.lengths
+            .propose(&s.captions, &s.encoder, prompt, max_frames)
     }
 
     /// What the model makes of a prompt, as lines for the user: for a bag-of-words model

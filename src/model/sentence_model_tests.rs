@@ -173,7 +173,12 @@ fn the_length_prior_gives_the_nearest_training_captions_length() {
     );
     // A bundle without lengths (older ones) proposes none; a broken file is named.
     let lengths = bundle_dir.join("lengths.json");
-    std::fs::write(&lengths, "{\"a person walks forward\": 0}").unwrap();
+    let text = std::fs::read_to_string(&lengths).unwrap();
+    assert!(
+        text.contains("\"frames\": 24") && text.contains("\"clips\": 1"),
+        "{text}"
+    );
+    std::fs::write(&lengths, text.replace("\"frames\": 24", "\"frames\": 0")).unwrap();
     let err = ModelBundle::load(&bundle_dir, &dev)
         .unwrap_err()
         .to_string();

@@ -86,31 +86,17 @@ impl CaptionIndex {
         }
     }
 
-    /// Nearest caption of `prompt` among those `keep` accepts; None when it accepts none.
-    pub fn nearest_among(
-        &self,
-        encoder: &SentenceEncoder,
-        prompt: &str,
-        keep: &dyn Fn(&str) -> bool,
-    ) -> Option<Nearest> {
+    /// Cosine of `prompt` with every caption, in [`Self::captions`]' order.
+    pub fn similarities(&self, encoder: &SentenceEncoder, prompt: &str) -> Vec<f32> {
         if self.captions.is_empty() {
-            return None;
+            return Vec::new();
         }
-        let sims = encoder
+        encoder
             .encode(&[prompt])
             .matmul(self.embeddings.clone().transpose())
             .into_data()
             .try_to_vec_as::<f32>()
-            .expect("float tensors read back as f32");
-        self.captions
-            .iter()
-            .zip(sims)
-            .filter(|(c, _)| keep(c))
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(caption, cosine)| Nearest {
-                caption: caption.clone(),
-                cosine,
-            })
+            .expect("float tensors read back as f32")
     }
 
     /// Writes the index as SafeTensors (f16).
