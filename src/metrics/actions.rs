@@ -12,6 +12,7 @@
 use crate::model::ModelBundle;
 use crate::model::generate::{GenerateError, GenerateRequest, generate};
 use crate::model::sampler::SamplerKind;
+use crate::metrics::per_motion::total_turn;
 use crate::motion::Motion;
 use burn::prelude::*;
 
@@ -28,6 +29,8 @@ const R_WRIST: usize = 21;
 pub struct Track {
     y: Vec<[f32; 22]>,
     pelvis_xz: Vec<[f32; 2]>,
+    /// Net turn of the pelvis path (degrees, + = left; [`total_turn`]).
+    turn: f32,
 }
 
 /// Heights and ground path of a motion.
@@ -47,6 +50,7 @@ pub fn track(m: &Motion) -> Track {
             .iter()
             .map(|p| [p[PELVIS].x, p[PELVIS].z])
             .collect(),
+        turn: total_turn(m),
     }
 }
 
@@ -149,6 +153,20 @@ pub const CASES: &[Case] = &[
         value: Track::speed,
         pass: |v| v >= 2.0 / 6.0,
         seconds: Some(6.0),
+    },
+    Case {
+        prompt: "a person walks and turns left",
+        what: "net turn of the path (deg, + = left, ≥ 45)",
+        value: |t| t.turn,
+        pass: |v| v >= 45.0,
+        seconds: None,
+    },
+    Case {
+        prompt: "a person walks and turns right",
+        what: "net turn of the path (deg, + = left, ≤ −45)",
+        value: |t| t.turn,
+        pass: |v| v <= -45.0,
+        seconds: None,
     },
     Case {
         prompt: "a person strolls",
