@@ -24,7 +24,7 @@ pub enum BenchCommand {
     /// unguided sampler (time ratios, latent seconds per motion).
     Solvers(super::bench_solvers::SolverBenchArgs),
     /// What the prior does with named actions: jump, kick, crouch, pick up, lie down, run,
-    /// walk, turns, a paraphrase, hand raises (seeds 1 and 2, one number each, ✗ below threshold).
+    /// walk, turns, paraphrases, hand raises (seeds 1 and 2, one number each, ✗ below threshold).
     Actions(ActionBenchArgs),
 }
 

@@ -176,6 +176,13 @@ pub const CASES: &[Case] = &[
         seconds: None,
     },
     Case {
+        prompt: "a person hurries",
+        what: "speed (m/s, ≥ 0.34, like its neighbours: walks)",
+        value: Track::speed,
+        pass: |v| v >= 2.0 / 6.0,
+        seconds: None,
+    },
+    Case {
         prompt: "a person raises both hands",
         what: "wrists over the head (m above the head's lowest, > 0)",
         value: |t| {
