@@ -9,10 +9,10 @@
 //! Heights are above the motion's own floor (its lowest ankle or toe), so a model that
 //! floats or sinks a little is not rewarded or punished for it.
 
+use crate::metrics::per_motion::total_turn;
 use crate::model::ModelBundle;
 use crate::model::generate::{GenerateError, GenerateRequest, generate};
 use crate::model::sampler::SamplerKind;
-use crate::metrics::per_motion::total_turn;
 use crate::motion::Motion;
 use burn::prelude::*;
 

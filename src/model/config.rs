@@ -115,6 +115,9 @@ pub struct TrainConfig {
     /// Weight of the velocity loss on the stored joint positions (0 disables).
     #[serde(default)]
     pub velocity_loss: f64,
+    /// Weight of the bone-length loss on the predicted pose, in cm² per bone (0 disables).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bone_loss: f64,
     /// Weight of an extra x0 MSE on the 4 root columns (yaw velocity, XZ velocity,
     /// height), averaged over those columns alone: the base MSE gives each of them 1/263
     /// of the loss, and a turn is the integral of the yaw velocity over the clip, so a
@@ -157,6 +160,7 @@ impl Default for TrainConfig {
             checkpoint_every: 200,
             foot_loss: 0.0,
             velocity_loss: 0.0,
+            bone_loss: 0.0,
             root_loss: 0.0,
             word_drop: 0.0,
             source_weights: Default::default(),
@@ -164,6 +168,10 @@ impl Default for TrainConfig {
             seed: 1,
         }
     }
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// Largest accepted layer width, head count, layer count, … of a configuration: far above
@@ -227,6 +235,7 @@ impl TrainConfig {
             ("weight_decay", self.weight_decay),
             ("foot_loss", self.foot_loss),
             ("velocity_loss", self.velocity_loss),
+            ("bone_loss", self.bone_loss),
             ("root_loss", self.root_loss),
         ] {
             if !(v.is_finite() && v >= 0.0) {

@@ -10,7 +10,7 @@ use crate::model::config::TrainConfig;
 use crate::model::denoiser::{Denoiser, DenoiserInput, Mdm};
 use crate::model::noise::NoiseSource;
 use crate::model::schedule::NoiseSchedule;
-use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT};
+use crate::skeleton::{BONE_LENGTHS, FOOT_LEFT, FOOT_RIGHT, NUM_JOINTS, PARENTS};
 use burn::prelude::*;
 
 /// A batch moved to tensors.
@@ -188,6 +188,69 @@ impl VelocityLoss {
     }
 }
 
+/// Bone-length loss: the squared difference, in cm², between each bone of the predicted
+/// pose and its length on the skeleton every training clip is retargeted to
+/// ([`BONE_LENGTHS`]), averaged over the 21 bones and the valid frames. The features store
+/// each joint's position on its own, so nothing else ties a forearm to one length; the
+/// wider prior's samples stretched bones by 4 % (std/mean over time; the chest 12 %)
+/// where the data's vary by 0. Lengths do not depend on the heading or the ground
+/// position, so the pose is read straight from the feature block: the pelvis at
+/// `(0, root height, 0)` and the 21 root-relative joints.
+pub struct BoneLoss {
+    /// Weight of the term in the training loss.
+    pub weight: f32,
+    /// `[1, 1, 64]` feature mean of the position block.
+    pub mean: Tensor<3>,
+    /// `[1, 1, 64]` feature std of the position block.
+    pub std: Tensor<3>,
+    /// `[1, 1, 21]` bone lengths in cm, bones 1..22 (child joint order).
+    pub lengths: Tensor<3>,
+}
+
+impl BoneLoss {
+    /// The loss for a dataset's statistics, or None when `weight` is 0.
+    pub fn new(weight: f64, mean: &[f32], std: &[f32], device: &Device) -> Option<Self> {
+        let block = |v: &[f32]| {
+            let cols = v[POSITION_COLUMNS].to_vec();
+            let len = cols.len();
+            Tensor::from_data(TensorData::new(cols, [1, 1, len]), device)
+        };
+        let lengths: Vec<f32> = BONE_LENGTHS[1..].iter().map(|l| l * 100.0).collect();
+        (weight > 0.0).then(|| BoneLoss {
+            weight: weight as f32,
+            mean: block(mean),
+            std: block(std),
+            lengths: Tensor::from_data(TensorData::new(lengths, [1, 1, NUM_JOINTS - 1]), device),
+        })
+    }
+
+    /// The term for a normalised prediction `[B, N, 263]`, `valid` `[B, N, 1]`.
+    pub fn term(&self, pred: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+        let [b, n, _] = pred.dims();
+        let device = pred.device();
+        let cols = POSITION_COLUMNS;
+        let block = (pred.narrow(2, cols.start, cols.len()) * self.std.clone() + self.mean.clone())
+            .mul_scalar(100.0);
+        let height = block.clone().narrow(2, 0, 1);
+        let zero = Tensor::<3>::zeros([b, n, 1], &device);
+        let pelvis = Tensor::cat(vec![zero.clone(), height, zero], 2);
+        let joints = Tensor::cat(vec![pelvis, block.narrow(2, 1, cols.len() - 1)], 2)
+            .reshape([b, n, NUM_JOINTS, 3]);
+        let parents: Vec<i64> = PARENTS[1..].iter().map(|&p| p as i64).collect();
+        let parents = Tensor::from_data(TensorData::new(parents, [NUM_JOINTS - 1]), &device);
+        let children = joints.clone().narrow(2, 1, NUM_JOINTS - 1);
+        let bones = children - joints.select(2, parents);
+        let length = bones
+            .powi_scalar(2)
+            .sum_dim(3)
+            .reshape([b, n, NUM_JOINTS - 1]);
+        // sqrt(x + ε): a zero-length bone has no direction, and its gradient stays finite.
+        let length = length.add_scalar(1e-6).sqrt();
+        let err = (length - self.lengths.clone()).powi_scalar(2) * valid.clone();
+        err.sum() / ((valid.sum() + 1.0) * (NUM_JOINTS - 1) as f32)
+    }
+}
+
 /// The geometric terms added to the x0 MSE in training (each None when its weight is 0).
 #[derive(Default)]
 pub struct GeometricLosses {
@@ -195,6 +258,8 @@ pub struct GeometricLosses {
     pub foot: Option<FootLoss>,
     /// MDM's velocity term.
     pub velocity: Option<VelocityLoss>,
+    /// The bone-length term.
+    pub bones: Option<BoneLoss>,
     /// Weight of the extra root-column MSE (None when 0).
     pub root: Option<f32>,
     /// The x0 MSE per clip ([`per_clip_mse`]) rather than per frame.
@@ -207,6 +272,7 @@ impl GeometricLosses {
         GeometricLosses {
             foot: FootLoss::new(cfg.foot_loss, mean, std, device),
             velocity: VelocityLoss::new(cfg.velocity_loss, std, device),
+            bones: BoneLoss::new(cfg.bone_loss, mean, std, device),
             root: (cfg.root_loss > 0.0).then_some(cfg.root_loss as f32),
             per_clip: cfg.loss_per_clip,
         }
@@ -240,6 +306,9 @@ pub(super) fn batch_loss(
             + v.term(pred.clone(), x0.clone(), valid.clone())
                 .mul_scalar(v.weight);
     }
+    if let Some(l) = &geometric.bones {
+        loss = loss + l.term(pred.clone(), valid.clone()).mul_scalar(l.weight);
+    }
     if let Some(w) = geometric.root {
         loss = loss + root_mse(pred, x0, valid).mul_scalar(w);
     }
@@ -267,5 +336,42 @@ mod tests {
         let per_clip = per_clip_mse(pred, x0, valid).into_scalar::<f32>();
         assert!((per_frame - 1.0).abs() < 1e-6, "{per_frame}"); // 4 / 4 frames
         assert!((per_clip - 2.0).abs() < 1e-6, "{per_clip}"); // (4/1 + 0/3) / 2
+    }
+
+    /// Features of the rest pose (pelvis 0.93 m up, every joint root-relative), `[1, 2, 263]`.
+    fn rest_features(stretch_left_forearm: f32) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        let pose = crate::skeleton::rest_pose();
+        let mut row = vec![0.0f32; FEATURE_DIM];
+        row[ROOT_Y.start] = pose[0].y;
+        for j in 1..NUM_JOINTS {
+            let mut p = pose[j] - pose[0];
+            p.y += pose[0].y;
+            if j == 20 {
+                // The left wrist (a leaf) moved along the forearm: only that bone grows.
+                p += (pose[20] - pose[18]).normalize() * stretch_left_forearm;
+            }
+            for a in 0..3 {
+                row[RIC.start + (j - 1) * 3 + a] = p[a];
+            }
+        }
+        let x = [row.clone(), row].concat();
+        (x, vec![0.0; FEATURE_DIM], vec![1.0; FEATURE_DIM])
+    }
+
+    #[test]
+    fn bone_loss_is_zero_on_the_skeleton_and_counts_a_stretch_in_cm() {
+        let device = Device::default();
+        let valid = Tensor::<3>::ones([1, 2, 1], &device);
+        let term = |stretch: f32| {
+            let (x, mean, std) = rest_features(stretch);
+            let loss = BoneLoss::new(1.0, &mean, &std, &device).unwrap();
+            let pred = Tensor::<3>::from_data(TensorData::new(x, [1, 2, FEATURE_DIM]), &device);
+            loss.term(pred, valid.clone()).into_scalar::<f32>()
+        };
+        assert!(term(0.0) < 1e-3, "{}", term(0.0));
+        // One bone 2 cm long on both frames: 4 cm² / 21 bones, (2 frames / 3) of the mean.
+        let stretched = term(0.02);
+        let want = 4.0 / 21.0 * 2.0 / 3.0;
+        assert!((stretched - want).abs() < 0.02, "{stretched} vs {want}");
     }
 }
