@@ -335,3 +335,27 @@ fn strided_and_broadcast_operands_and_slice_writes_are_exact() {
         &g[..6]
     );
 }
+
+#[test]
+fn first_dim_sums_split_by_columns_are_exact() {
+    let device = Device::flex();
+    // [rows, cols]: small (one thread), large with a ragged last column chunk, and the
+    // shape of a bias gradient ([B·N, D] = [3872, 256]) seen as [32, 121·256].
+    for (rows, cols) in [(7, 100), (33, 4_099), (32, 121 * 256)] {
+        let v = random(rows * cols, -1.0, 1.0, 11);
+        let t: Tensor<2> = Tensor::from_data(TensorData::new(v.clone(), [rows, cols]), &device);
+        let got = t
+            .sum_dim(0)
+            .into_data()
+            .try_into_vec::<f32>()
+            .unwrap();
+        // The same order as the kernel: each column summed row by row from 0.
+        let want: Vec<f32> = (0..cols)
+            .map(|c| (0..rows).fold(0.0f32, |acc, r| acc + v[r * cols + c]))
+            .collect();
+        assert_eq!(got, want, "[{rows}, {cols}]");
+    }
+    // A fresh tensor's storage is zero, whatever its element width.
+    let z: Tensor<3> = Tensor::zeros([3, 5, 7], &device);
+    assert!(values(z.reshape([105])).iter().all(|&x| x == 0.0));
+}

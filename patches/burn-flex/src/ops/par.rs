@@ -15,7 +15,7 @@ pub(crate) const PAR_MIN_ELEMS: usize = 32 * 1024;
 
 /// Elements per rayon task (a multiple of 64 keeps chunk starts cache-line aligned).
 #[cfg(feature = "rayon")]
-fn chunk_len(len: usize) -> usize {
+pub(crate) fn chunk_len(len: usize) -> usize {
     let tasks = 4 * rayon::current_num_threads().max(1);
     (len.div_ceil(tasks)).div_ceil(64).max(1) * 64
 }

@@ -1124,6 +1124,29 @@ fn reduce_first_dim_f32(
     {
         // Use aligned allocation for optimal SIMD scatter-add
         let mut result = aligned::alloc_aligned_zeroed::<f32>(inner_size);
+        // mprog patch: columns split across the rayon pool when the input is large (a
+        // bias gradient sums a [B·N, D] activation gradient on the calling thread,
+        // 11 % of a training step's main-thread samples). Each column is still summed
+        // row by row in order: exact.
+        #[cfg(feature = "rayon")]
+        if dim_size * inner_size >= crate::ops::par::PAR_MIN_ELEMS && inner_size >= 128 {
+            use rayon::prelude::*;
+            let chunk = crate::ops::par::chunk_len(inner_size);
+            result
+                .par_chunks_mut(chunk)
+                .enumerate()
+                .for_each(|(i, cols)| {
+                    let len = cols.len();
+                    kernels::scatter_add_f32(
+                        &data[start_offset + i * chunk..],
+                        cols,
+                        dim_size,
+                        len,
+                        dim_stride as usize,
+                    );
+                });
+            return aligned::to_vec(result);
+        }
         kernels::scatter_add_f32(
             &data[start_offset..],
             &mut result,
