@@ -77,6 +77,23 @@ where
     src.iter().map(|&x| op(x)).collect()
 }
 
+/// `n` zeros, written across the rayon pool when `n` is large. New tensors (every matmul
+/// output) are zeroed on the calling thread otherwise, while the workers wait.
+pub(crate) fn zeroed<T: bytemuck::Zeroable + Copy + Send + Sync>(n: usize) -> alloc::vec::Vec<T> {
+    #[cfg(feature = "rayon")]
+    if n >= PAR_MIN_ELEMS {
+        use rayon::prelude::*;
+        let mut out = alloc::vec::Vec::with_capacity(n);
+        out.spare_capacity_mut()[..n]
+            .par_chunks_mut(chunk_len(n))
+            .for_each(|c| c.fill(core::mem::MaybeUninit::new(T::zeroed())));
+        // Safety: every one of the n elements was written just above.
+        unsafe { out.set_len(n) };
+        return out;
+    }
+    alloc::vec![T::zeroed(); n]
+}
+
 // ---------------------------------------------------------------------------------------
 // Branch-free f32 math (vectorised by LLVM inside the `with_simd` kernels below)
 // ---------------------------------------------------------------------------------------
