@@ -344,11 +344,7 @@ fn first_dim_sums_split_by_columns_are_exact() {
     for (rows, cols) in [(7, 100), (33, 4_099), (32, 121 * 256)] {
         let v = random(rows * cols, -1.0, 1.0, 11);
         let t: Tensor<2> = Tensor::from_data(TensorData::new(v.clone(), [rows, cols]), &device);
-        let got = t
-            .sum_dim(0)
-            .into_data()
-            .try_into_vec::<f32>()
-            .unwrap();
+        let got = t.sum_dim(0).into_data().try_into_vec::<f32>().unwrap();
         // The same order as the kernel: each column summed row by row from 0.
         let want: Vec<f32> = (0..cols)
             .map(|c| (0..rows).fold(0.0f32, |acc, r| acc + v[r * cols + c]))
