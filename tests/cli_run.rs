@@ -226,3 +226,49 @@ fn eval_refuses_an_unknown_sampler_before_loading_anything() {
     let out = run(&["eval", "--data", "/nonexistent", "--steps", "0"]);
     assert!(text(&out).1.contains("--steps ≥ 1"));
 }
+
+#[test]
+fn a_bundle_with_a_controlnet_adds_guide_without_realism_to_the_task_table() {
+    use burn::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    std::fs::create_dir_all(&model).unwrap();
+    let shipped = mprog::model::weights::default_model_dir();
+    for entry in std::fs::read_dir(&shipped).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_file() {
+            std::fs::copy(&p, model.join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    let device = Device::flex();
+    let bundle = mprog::model::ModelBundle::load(&model, &device).unwrap();
+    // Zero-initialised: a no-op, enough to make the run measure both rows.
+    mprog::model::control::ControlNet::from_base(&bundle.model, &device)
+        .save(&model, true)
+        .unwrap();
+    let md = dir.path().join("tasks.md");
+    let out = run(&[
+        "bench",
+        "tasks",
+        "--quick",
+        "--model",
+        model.to_str().unwrap(),
+        "--solvers",
+        "guide",
+        "--knob",
+        "guide.steps=10",
+        "--knob",
+        "guide.k_late=10",
+        "--family",
+        "pmg",
+        "--data",
+        "/nonexistent",
+        "-o",
+        md.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let table = std::fs::read_to_string(&md).unwrap();
+    assert!(table.contains("| guide |"), "{table}");
+    assert!(table.contains("| guide, realism 0 |"), "{table}");
+}

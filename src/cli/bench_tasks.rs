@@ -6,6 +6,7 @@ use mprog::dataset::{Dataset, FEATURE_DIM, Split};
 use mprog::metrics::evaluator::{Evaluator, default_evaluator_dir};
 use mprog::metrics::scores::fid;
 use mprog::model::ModelBundle;
+use mprog::model::control::ControlNet;
 use mprog::model::weights::default_model_dir;
 use mprog::solve::{Prior, Solver};
 use mprog::tasks::head_height;
@@ -75,6 +76,29 @@ fn parse_knob(s: &str) -> Result<(String, String, f64), String> {
         .parse()
         .map_err(|_| format!("`{value}` is not a number"))?;
     Ok((solver.trim().into(), knob.trim().into(), value))
+}
+
+/// Row label of guide run without the ControlNet.
+pub const GUIDE_NO_REALISM: &str = "guide, realism 0";
+
+/// `list` with a copy of `guide` at `realism = 0` after it, when the bundle has a
+/// ControlNet (without one the two would be the same run).
+fn with_no_realism_guide(
+    list: Vec<(Solver, String)>,
+    has_control: bool,
+) -> Result<Vec<(Solver, String)>> {
+    let mut out = Vec::with_capacity(list.len() + 1);
+    for (solver, label) in list {
+        let copy = (has_control && solver.name() == "guide").then(|| solver.clone());
+        out.push((solver, label));
+        if let Some(mut plain) = copy {
+            plain
+                .set_knob("realism", 0.0)
+                .map_err(|e| miette!("guide's realism knob: {e}"))?;
+            out.push((plain, GUIDE_NO_REALISM.to_string()));
+        }
+    }
+    Ok(out)
 }
 
 /// The solvers of this run, with `--solvers` and `--knob` applied.
@@ -179,7 +203,13 @@ fn realism(
 pub fn run(args: TaskBenchArgs) -> Result<()> {
     let started = Instant::now();
     let device = super::device()?;
-    let list = chosen_solvers(&args)?;
+    let list: Vec<(Solver, String)> = chosen_solvers(&args)?
+        .into_iter()
+        .map(|s| {
+            let label = s.name().to_string();
+            (s, label)
+        })
+        .collect();
     let size = if args.quick {
         SuiteSize::quick()
     } else {
@@ -189,7 +219,12 @@ pub fn run(args: TaskBenchArgs) -> Result<()> {
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model")?;
-    let prior = Prior::from_bundle(&bundle);
+    // A realism ControlNet beside the weights steers `guide` by default; the run then also
+    // measures guide without it (`realism = 0`), its own row in every table.
+    let control = ControlNet::load(&dir, &bundle.model, bundle.manifest.half_precision, &device)
+        .into_diagnostic()?;
+    let prior = Prior::from_bundle(&bundle).with_control(control.as_ref());
+    let list = with_no_realism_guide(list, control.is_some())?;
     let mut tasks: Vec<Task> = program_suite(&args.programs, &size).map_err(|e| miette!("{e}"))?;
     let data = match Dataset::load(&args.data) {
         Ok(d) => Some(d),
@@ -231,22 +266,18 @@ pub fn run(args: TaskBenchArgs) -> Result<()> {
     );
     let mut rows = Vec::with_capacity(runs);
     for task in &tasks {
-        for solver in &list {
-            bar.set_prefix(format!(
-                "{}/{runs} {} {}",
-                rows.len() + 1,
-                task.name,
-                solver.name()
-            ));
-            let row = run_task(&prior, task, solver, args.seed, &device, &mut |p| {
+        for (solver, label) in &list {
+            bar.set_prefix(format!("{}/{runs} {} {label}", rows.len() + 1, task.name));
+            let mut row = run_task(&prior, task, solver, args.seed, &device, &mut |p| {
                 bar.set_length(p.total as u64);
                 bar.set_position(p.done as u64);
                 if let Some(e) = p.error {
                     bar.set_message(format!("error {e:.4}"));
                 }
             });
+            row.solver = label.clone();
             let line = if let Some(f) = &row.failure {
-                format!("{} / {}: failed: {f}", task.name, solver.name())
+                format!("{} / {label}: failed: {f}", task.name)
             } else {
                 format!(
                     "{:<28} {:<7} error {:.4}  unsuccess {:.2}  skating {:.3}  accel {:.3}  {:.1} s/sample",
@@ -283,7 +314,10 @@ pub fn run(args: TaskBenchArgs) -> Result<()> {
             .collect::<Vec<_>>()
             .join(" ")
             .replace("bench tasks", "mprog bench tasks"),
-        solvers: list.iter().map(|s| format!("{s:?}")).collect(),
+        solvers: list
+            .iter()
+            .map(|(s, label)| format!("{label}: {s:?}"))
+            .collect(),
         seconds: started.elapsed().as_secs_f64(),
     };
     let md = markdown(&info, &rows, &realism);
