@@ -355,3 +355,30 @@ fn first_dim_sums_split_by_columns_are_exact() {
     let z: Tensor<3> = Tensor::zeros([3, 5, 7], &device);
     assert!(values(z.reshape([105])).iter().all(|&x| x == 0.0));
 }
+
+#[test]
+fn large_broadcast_and_strided_binary_ops_are_exact() {
+    let device = Device::flex();
+    let (rows, cols) = (300, 257); // 77K elements: the parallel path, a ragged last task
+    let a = random(rows * cols, -2.0, 2.0, 21);
+    let bias = random(cols, -1.0, 1.0, 22);
+    let a_t = || Tensor::<2>::from_data(TensorData::new(a.clone(), [rows, cols]), &device);
+    let bias_t = Tensor::<2>::from_data(TensorData::new(bias.clone(), [1, cols]), &device);
+    let flat = |t: Tensor<2>| t.into_data().try_into_vec::<f32>().unwrap();
+    let want: Vec<f32> = (0..rows * cols).map(|i| a[i] * bias[i % cols]).collect();
+    // Uniquely owned lhs: written in place.
+    assert_eq!(flat(a_t() * bias_t.clone()), want);
+    // Shared lhs: a new output.
+    let shared = a_t();
+    let keep = shared.clone();
+    assert_eq!(flat(shared * bias_t.clone()), want);
+    drop(keep);
+    // A transposed (strided) operand against a contiguous one.
+    let b = random(rows * cols, -1.0, 1.0, 23);
+    let bt = Tensor::<2>::from_data(TensorData::new(b.clone(), [cols, rows]), &device).transpose();
+    let want: Vec<f32> = (0..rows * cols)
+        .map(|i| a[i] - b[(i % cols) * rows + i / cols])
+        .collect();
+    let keep = a_t();
+    assert_eq!(flat(keep.clone() - bt), want);
+}

@@ -303,6 +303,188 @@ where
 }
 
 // ============================================================================
+// mprog patch: the same loops split across the rayon pool
+// ============================================================================
+
+impl ZipNest {
+    /// Number of innermost runs (the product of the outer collapsed dims).
+    pub fn runs(&self) -> usize {
+        self.shape[..self.ndim.saturating_sub(1)].iter().product()
+    }
+
+    /// Runs `first .. first + count` of [`Self::for_each_run`]'s sequence, the same bases
+    /// in the same order. Must not be called when `ndim == 0` or a dim is empty.
+    pub fn for_runs(&self, first: usize, count: usize, mut f: impl FnMut(usize, usize)) {
+        let outer = self.ndim - 1;
+        let mut idx = [0usize; ZIP_MAX_RANK];
+        let mut lhs_base = self.lhs_offset as isize;
+        let mut rhs_base = self.rhs_offset as isize;
+        let mut rem = first;
+        for d in (0..outer).rev() {
+            idx[d] = rem % self.shape[d];
+            rem /= self.shape[d];
+            lhs_base += idx[d] as isize * self.lhs_strides[d];
+            rhs_base += idx[d] as isize * self.rhs_strides[d];
+        }
+        for r in 0..count {
+            f(lhs_base as usize, rhs_base as usize);
+            if r + 1 == count {
+                break;
+            }
+            let mut d = outer;
+            while d > 0 {
+                d -= 1;
+                idx[d] += 1;
+                lhs_base += self.lhs_strides[d];
+                rhs_base += self.rhs_strides[d];
+                if idx[d] < self.shape[d] {
+                    break;
+                }
+                idx[d] = 0;
+                lhs_base -= (self.shape[d] as isize) * self.lhs_strides[d];
+                rhs_base -= (self.shape[d] as isize) * self.rhs_strides[d];
+            }
+        }
+    }
+
+    /// Runs per rayon task when the nest is worth splitting (at least
+    /// `PAR_MIN_ELEMS` elements, two runs); None otherwise.
+    #[cfg(feature = "rayon")]
+    fn runs_per_task(&self) -> Option<usize> {
+        if self.ndim < 2 || self.shape[..self.ndim].contains(&0) {
+            return None;
+        }
+        let (len, _, _) = self.inner();
+        let runs = self.runs();
+        if runs < 2 || runs * len < crate::ops::par::PAR_MIN_ELEMS {
+            return None;
+        }
+        Some(runs.div_ceil(4 * rayon::current_num_threads().max(1)).max(1))
+    }
+}
+
+/// One run of `len` elements: `out[j] = op(lhs[lb + j·ls], rhs[rb + j·rs])`, written
+/// into uninitialised output, with the unit- and zero-stride cases written out so that
+/// they vectorise.
+#[cfg(feature = "rayon")]
+#[inline]
+fn zip_run<L: Copy, R: Copy, Out>(
+    out: &mut [core::mem::MaybeUninit<Out>],
+    lhs: &[L],
+    rhs: &[R],
+    (lb, ls): (usize, isize),
+    (rb, rs): (usize, isize),
+    op: &impl Fn(L, R) -> Out,
+) {
+    use core::mem::MaybeUninit;
+    let len = out.len();
+    match (ls, rs) {
+        (1, 1) => {
+            for ((o, &a), &b) in out.iter_mut().zip(&lhs[lb..lb + len]).zip(&rhs[rb..rb + len]) {
+                *o = MaybeUninit::new(op(a, b));
+            }
+        }
+        (1, 0) => {
+            let b = rhs[rb];
+            for (o, &a) in out.iter_mut().zip(&lhs[lb..lb + len]) {
+                *o = MaybeUninit::new(op(a, b));
+            }
+        }
+        (0, 1) => {
+            let a = lhs[lb];
+            for (o, &b) in out.iter_mut().zip(&rhs[rb..rb + len]) {
+                *o = MaybeUninit::new(op(a, b));
+            }
+        }
+        _ => {
+            for (j, o) in out.iter_mut().enumerate() {
+                *o = MaybeUninit::new(op(lhs[lb + j * ls as usize], rhs[rb + j * rs as usize]));
+            }
+        }
+    }
+}
+
+/// [`zip_apply_inplace`] split by runs across the rayon pool when large (the bias add of
+/// a linear layer, `[B·N, D] += [D]`, ran on the calling thread). Bit-identical: every
+/// element gets the same single `op`.
+pub(crate) fn zip_apply_inplace_par<D, S, F>(nest: &ZipNest, dst: &mut [D], src: &[S], op: F)
+where
+    D: Copy + Send + Sync,
+    S: Copy + Sync,
+    F: Fn(D, S) -> D + Send + Sync,
+{
+    #[cfg(feature = "rayon")]
+    if let Some(per) = nest.runs_per_task() {
+        use rayon::prelude::*;
+        let (len, _, r_st) = nest.inner();
+        let total = nest.runs() * len;
+        let base = nest.lhs_offset;
+        dst[base..base + total]
+            .par_chunks_mut(per * len)
+            .enumerate()
+            .for_each(|(i, chunk)| {
+                let mut k = 0;
+                nest.for_runs(i * per, chunk.len() / len, |_, rb| {
+                    let run = &mut chunk[k * len..(k + 1) * len];
+                    k += 1;
+                    // In place: the destination is its own lhs (stride 1 from the run).
+                    for (j, d) in run.iter_mut().enumerate() {
+                        let s = if r_st == 0 {
+                            src[rb]
+                        } else {
+                            src[rb + j * r_st as usize]
+                        };
+                        *d = op(*d, s);
+                    }
+                });
+            });
+        return;
+    }
+    zip_apply_inplace(nest, dst, src, op)
+}
+
+/// [`zip_map`] split by runs across the rayon pool when large. Bit-identical.
+pub(crate) fn zip_map_par<L, R, Out, F>(
+    lhs: &[L],
+    lhs_layout: &Layout,
+    rhs: &[R],
+    rhs_layout: &Layout,
+    op: F,
+) -> Option<Vec<Out>>
+where
+    L: Copy + Sync,
+    R: Copy + Sync,
+    Out: Send,
+    F: Fn(L, R) -> Out + Send + Sync,
+{
+    #[cfg(feature = "rayon")]
+    {
+        let nest = collapse_for_zip(lhs_layout, rhs_layout)?;
+        if let Some(per) = nest.runs_per_task() {
+            use rayon::prelude::*;
+            let (len, l_st, r_st) = nest.inner();
+            let total = nest.runs() * len;
+            let mut out: Vec<Out> = Vec::with_capacity(total);
+            out.spare_capacity_mut()[..total]
+                .par_chunks_mut(per * len)
+                .enumerate()
+                .for_each(|(i, chunk)| {
+                    let mut k = 0;
+                    nest.for_runs(i * per, chunk.len() / len, |lb, rb| {
+                        let run = &mut chunk[k * len..(k + 1) * len];
+                        k += 1;
+                        zip_run(run, lhs, rhs, (lb, l_st), (rb, r_st), &op);
+                    });
+                });
+            // Safety: the chunks cover 0..total and every run wrote each of its elements.
+            unsafe { out.set_len(total) };
+            return Some(out);
+        }
+    }
+    zip_map(lhs, lhs_layout, rhs, rhs_layout, op)
+}
+
+// ============================================================================
 // 3-way zip support (for mask_where and ternary operations)
 // ============================================================================
 
