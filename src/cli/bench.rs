@@ -48,10 +48,8 @@ fn bench_actions(args: ActionBenchArgs) -> Result<()> {
     let bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot load the model {}", dir.display()))?;
-    if let Some(s) = args.seconds
-        && !(s.is_finite() && s > 0.0)
-    {
-        miette::bail!("--seconds must be a positive number of seconds, got {s}");
+    if let Some(s) = args.seconds {
+        super::generate::seconds_to_frames(s)?;
     }
     let rows = mprog::metrics::actions::measure_actions(&bundle, &device, args.seconds)
         .into_diagnostic()?;

@@ -65,7 +65,7 @@ pub struct GenArgs {
 const DEFAULT_FRAMES: usize = 120;
 
 /// `--seconds` in frames at 20 fps; refused when not a positive finite number.
-fn seconds_to_frames(seconds: f32) -> Result<usize> {
+pub(super) fn seconds_to_frames(seconds: f32) -> Result<usize> {
     if seconds.is_finite() && seconds > 0.0 {
         Ok(((seconds * 20.0).round() as usize).max(1))
     } else {

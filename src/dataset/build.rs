@@ -15,7 +15,7 @@ use super::stats::feature_stats;
 use super::store::{
     ClipInfo, DATASET_VERSION, DatasetIndex, FEATURE_DIM, Split, SplitStats, write_f32_npy,
 };
-use super::takes::{Unit, plan_units, take_name};
+use super::takes::{Unit, plan_units};
 use crate::features::{ExtractOptions, extract, recover_from_ric};
 use crate::formats::bvh::{BvhImport, BvhImportOptions, import_bvh, import_parsed};
 use crate::motion::Motion;
@@ -227,24 +227,14 @@ fn convert_unit(unit: Unit, root: &Path, ctx: &LabelContext, opts: &BuildOptions
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_default();
     let files = unit.file_count();
+    let name = unit.name();
     let text = clip_text(&stem, ctx);
     let family = text.as_ref().map_or("?", |t| t.family);
-    let (name, import) = match unit {
-        Unit::File(path) => (stem.clone(), import_file(&path)),
+    let import = match unit {
+        Unit::File(path) => import_file(&path),
         Unit::Take { files, bvh } => {
-            let last = files
-                .last()
-                .and_then(|p| p.file_stem())
-                .map_or_else(|| stem.clone(), |s| s.to_string_lossy().to_string());
-            let number = last
-                .split('_')
-                .nth(3)
-                .and_then(|n| n.parse().ok())
-                .unwrap_or(0);
             let origin = format!("{} (+{} cuts)", files[0].display(), files.len() - 1);
-            let import = import_parsed(&origin, bvh, &BvhImportOptions::default())
-                .map_err(|e| e.to_string());
-            (take_name(&stem, number), import)
+            import_parsed(&origin, bvh, &BvhImportOptions::default()).map_err(|e| e.to_string())
         }
     };
     let (rig, clips) = match text.and_then(|t| import.map(|i| (t, i))) {

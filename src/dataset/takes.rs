@@ -49,6 +49,23 @@ impl Unit {
     pub fn file_count(&self) -> usize {
         self.files().len()
     }
+
+    /// The clip's name: the file stem, or for a take its first and last cut numbers
+    /// (`HDM_bd_squat1Reps_001-004_120`).
+    pub fn name(&self) -> String {
+        let stem = |p: &Path| {
+            p.file_stem()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_default()
+        };
+        match self {
+            Unit::File(p) => stem(p),
+            Unit::Take { files, .. } => {
+                let last = files.last().and_then(|p| cut_id(p)).map_or(0, |id| id.2);
+                take_name(&stem(&files[0]), last)
+            }
+        }
+    }
 }
 
 /// `(actor, class, number)` of an HDM05 cut `HDM_<actor>_<class>_<nnn>[_<fps>].bvh`.
@@ -68,7 +85,7 @@ fn cut_id(path: &Path) -> Option<(String, String, u32)> {
 }
 
 /// The name of a take joined from cuts `first..=last`: `HDM_bd_squat1Reps_001-004_120`.
-pub fn take_name(first_stem: &str, last_number: u32) -> String {
+fn take_name(first_stem: &str, last_number: u32) -> String {
     let parts: Vec<&str> = first_stem.split('_').collect();
     match parts.get(3) {
         Some(num) => {
@@ -233,6 +250,7 @@ mod tests {
             vec![0., 0., 0., 1., 0., 0., 2., 0., 0., 3., 0., 0.]
         );
         assert_eq!(units[0].file_count(), 3);
+        assert_eq!(units[0].name(), "HDM_bd_hop_001-003_120");
         for (u, f) in units[1..].iter().zip(&files[3..]) {
             assert!(matches!(u, Unit::File(p) if p == f));
         }
