@@ -382,3 +382,24 @@ fn large_broadcast_and_strided_binary_ops_are_exact() {
     let keep = a_t();
     assert_eq!(flat(keep.clone() - bt), want);
 }
+
+#[test]
+fn one_long_strided_run_splits_exactly() {
+    // The x column of `[32, 196, 22, 3]` joints collapses to one run of 137,984 elements
+    // at stride 3: against a broadcast scalar (a new output) and as the source of an
+    // in-place op on a uniquely owned contiguous tensor. Both split across the pool.
+    let device = Device::flex();
+    let (b, n, j) = (32, 196, 22);
+    let rows = b * n * j;
+    let v = random(rows * 3, -2.0, 2.0, 31);
+    let joints = Tensor::<4>::from_data(TensorData::new(v.clone(), [b, n, j, 3]), &device);
+    let x = joints.clone().slice([0..b, 0..n, 0..j, 0..1]);
+    let half = Tensor::<4>::from_data(TensorData::new(vec![0.5f32], [1, 1, 1, 1]), &device);
+    let flat = |t: Tensor<4>| t.into_data().try_into_vec::<f32>().unwrap();
+    let got = flat(x.clone() - half);
+    assert!((0..rows).all(|k| got[k] == v[k * 3] - 0.5));
+    let w = random(rows, -1.0, 1.0, 32);
+    let unique = Tensor::<4>::from_data(TensorData::new(w.clone(), [b, n, j, 1]), &device);
+    let got = flat(unique * x);
+    assert!((0..rows).all(|k| got[k] == w[k] * v[k * 3]));
+}

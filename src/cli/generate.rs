@@ -57,6 +57,10 @@ pub struct GenArgs {
     /// held in place after sampling, the path unchanged).
     #[arg(long)]
     raw: bool,
+    /// Give the model the prompt as written, even when it lies far from every training
+    /// caption (by default such a prompt is replaced by the mean of its nearest captions).
+    #[arg(long)]
+    literal_prompt: bool,
     #[command(flatten)]
     export: super::export::ExportArgs,
 }
@@ -95,9 +99,12 @@ pub fn run(args: GenArgs) -> Result<()> {
     args.export.check_against(&args.out)?;
     let device = super::device()?;
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
-    let bundle = ModelBundle::load(&dir, &device)
+    let mut bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
+    if args.literal_prompt {
+        bundle.text.read_literally();
+    }
     let frames = match (args.frames, args.seconds) {
         (Some(f), _) => f,
         (None, Some(s)) => seconds_to_frames(s)?,
@@ -167,6 +174,9 @@ pub fn run(args: GenArgs) -> Result<()> {
     meta.insert("sampler".into(), format!("{sampler:?}").into());
     meta.insert("guidance_scale".into(), (args.guidance as f64).into());
     meta.insert("foot_cleanup".into(), (!args.raw).into());
+    if let Some(snapped) = bundle.text.snapped(&args.text) {
+        meta.insert("conditioned_on".into(), snapped.neighbours.into());
+    }
     meta.insert(
         "weights_id".into(),
         bundle.manifest.weights_id.clone().into(),

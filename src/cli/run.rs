@@ -58,6 +58,10 @@ pub struct RunArgs {
     /// Skip the unguided comparison sample.
     #[arg(long)]
     no_baseline: bool,
+    /// Give the model the prompt as written, even when it lies far from every training
+    /// caption (by default such a prompt is replaced by the mean of its nearest captions).
+    #[arg(long)]
+    literal_prompt: bool,
     /// Model bundle folder (default: models/default).
     #[arg(long)]
     model: Option<PathBuf>,
@@ -166,9 +170,12 @@ pub fn run(args: RunArgs) -> Result<()> {
     args.export.check_against(&args.out)?;
     let device = super::device()?;
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
-    let bundle = ModelBundle::load(&dir, &device)
+    let mut bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;
+    if args.literal_prompt {
+        bundle.text.read_literally();
+    }
     // A realism ControlNet beside the weights steers `guide` (knob `realism`).
     let control = ControlNet::load(&dir, &bundle.model, bundle.manifest.half_precision, &device)
         .into_diagnostic()?;

@@ -9,6 +9,9 @@ use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+/// First timestep of the high-noise share (`TrainConfig::high_noise_fraction`).
+pub const HIGH_NOISE_FROM: usize = 900;
+
 /// A batch on the host, normalised, padded to the longest crop.
 #[derive(Clone, Debug)]
 pub struct HostBatch {
@@ -106,8 +109,16 @@ pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: us
         let caption = &clip.captions[rng.random_range(0..clip.captions.len())];
         captions.push(drop_words(caption, cfg.word_drop, &mut rng));
     }
+    // Without a high-noise share the draw is the plain uniform one (the same timesteps as
+    // runs made before the option existed).
     let timesteps = (0..b)
-        .map(|_| rng.random_range(0..DIFFUSION_STEPS))
+        .map(|_| {
+            if cfg.high_noise_fraction > 0.0 && rng.random::<f64>() < cfg.high_noise_fraction {
+                rng.random_range(HIGH_NOISE_FROM..DIFFUSION_STEPS)
+            } else {
+                rng.random_range(0..DIFFUSION_STEPS)
+            }
+        })
         .collect();
     let keep_text = (0..b)
         .map(|_| {

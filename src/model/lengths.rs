@@ -25,7 +25,7 @@ use std::path::Path;
 pub const MIN_FRAMES: usize = 20;
 
 /// Captions this close to the best cosine count as the prompt's neighbours.
-pub const MARGIN: f32 = 0.05;
+pub const MARGIN: f32 = super::sentence::NEIGHBOUR_MARGIN;
 
 /// Median length and clip count of one caption's training clips.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

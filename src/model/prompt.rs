@@ -4,7 +4,7 @@
 //! tell the user about a prompt); [`TextBatch`] is what travels in a `DenoiserInput`.
 
 use super::lengths::CaptionLengths;
-use super::sentence::{CaptionIndex, FAR_COSINE, Nearest, SentenceEncoder};
+use super::sentence::{CaptionIndex, FAR_COSINE, Nearest, SNAP_COSINE, SentenceEncoder, Snapped};
 use super::text::{TokenBatch, Vocabulary};
 use burn::prelude::*;
 use std::sync::Arc;
@@ -115,6 +115,25 @@ pub struct SentencePrompts {
     pub captions: CaptionIndex,
     /// Median clip length of each training caption (empty for older bundles).
     pub lengths: CaptionLengths,
+    /// A prompt whose best cosine with a caption is below this is conditioned on its
+    /// neighbours instead ([`CaptionIndex::snap`]); 0 reads every prompt as written.
+    pub snap_below: f32,
+}
+
+impl SentencePrompts {
+    /// Encoder, captions and lengths, snapping far prompts at [`SNAP_COSINE`].
+    pub fn new(
+        encoder: Arc<SentenceEncoder>,
+        captions: CaptionIndex,
+        lengths: CaptionLengths,
+    ) -> SentencePrompts {
+        SentencePrompts {
+            encoder,
+            captions,
+            lengths,
+            snap_below: SNAP_COSINE,
+        }
+    }
 }
 
 /// Turns prompts into a model's text condition.
@@ -147,12 +166,31 @@ impl PromptEncoder {
                 let mut all: Vec<&str> = prompts.to_vec();
                 all.extend(swapped.iter().map(String::as_str));
                 let both = s.encoder.encode(&all).to_device(device);
+                let (both, _) = s.captions.snap(both, s.snap_below);
                 TextBatch::Sentences(SentenceBatch {
                     vectors: both.clone().narrow(0, 0, b),
                     mirrored: both.narrow(0, b, b),
                 })
             }
         }
+    }
+
+    /// Reads every prompt as written (`--literal-prompt`): no snapping to the nearest
+    /// captions. Nothing changes for a bag-of-words model.
+    pub fn read_literally(&mut self) {
+        if let PromptEncoder::Sentences(s) = self {
+            s.snap_below = 0.0;
+        }
+    }
+
+    /// The neighbours that stand in for `prompt` when it is snapped; None when it is read
+    /// as written (or the model reads words).
+    pub fn snapped(&self, prompt: &str) -> Option<Snapped> {
+        let PromptEncoder::Sentences(s) = self else {
+            return None;
+        };
+        let vectors = s.encoder.encode(&[prompt]);
+        s.captions.snap(vectors, s.snap_below).1.pop().flatten()
     }
 
     /// Words of `prompt` the model cannot read (always none for a sentence encoder).
@@ -191,10 +229,14 @@ impl PromptEncoder {
     pub fn report(&self, prompt: &str) -> Vec<String> {
         match self {
             PromptEncoder::Words(vocab) => vocab.word_report(prompt),
-            PromptEncoder::Sentences(_) => match self.nearest_caption(prompt) {
-                Some(n) if n.cosine < FAR_COSINE => vec![far_prompt_line(&n)],
-                _ => Vec::new(),
-            },
+            PromptEncoder::Sentences(_) => {
+                let mut lines = match self.nearest_caption(prompt) {
+                    Some(n) if n.cosine < FAR_COSINE => vec![far_prompt_line(&n)],
+                    _ => Vec::new(),
+                };
+                lines.extend(self.snapped(prompt).map(|s| snapped_line(&s)));
+                lines
+            }
         }
     }
 }
@@ -204,6 +246,25 @@ pub fn far_prompt_line(n: &Nearest) -> String {
     format!(
         "the prompt is far from every caption the model was trained on (cosine {:.2} < {FAR_COSINE}); nearest known: \"{}\"",
         n.cosine, n.caption
+    )
+}
+
+/// The user-facing line for a prompt conditioned on its neighbours.
+pub fn snapped_line(s: &Snapped) -> String {
+    let shown: Vec<String> = s
+        .neighbours
+        .iter()
+        .take(3)
+        .map(|c| format!("\"{c}\""))
+        .collect();
+    let more = match s.neighbours.len().saturating_sub(3) {
+        0 => String::new(),
+        k => format!(" and {k} more"),
+    };
+    format!(
+        "the model has not read a caption like this (best cosine {:.2} < {SNAP_COSINE}): it is conditioned on the mean of its nearest captions, {}{more}; --literal-prompt reads it as written",
+        s.best,
+        shown.join(", ")
     )
 }
 

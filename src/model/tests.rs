@@ -375,3 +375,56 @@ fn a_run_with_input_skip_can_start_from_a_bundle_without_it() {
 fn mark_checkpoint(out: &std::path::Path) -> Result<(), String> {
     std::fs::write(out.join("hook.txt"), "ran").map_err(|e| e.to_string())
 }
+
+#[test]
+fn a_high_noise_share_draws_late_timesteps_and_none_keeps_the_old_draw() {
+    use super::batch::{HIGH_NOISE_FROM, draw_batch, step_rng};
+    use rand::Rng;
+    let data = synthetic_dataset();
+    let clips: Vec<&ClipInfo> = data.clips(Split::Train).collect();
+    let draws = |fraction: f64| -> Vec<usize> {
+        let cfg = TrainConfig {
+            batch_size: 64,
+            crop_frames: 16,
+            high_noise_fraction: fraction,
+            ..TrainConfig::default()
+        };
+        (0..8)
+            .flat_map(|step| draw_batch(&data, &clips, &cfg, step).timesteps)
+            .collect()
+    };
+    let all_late = draws(1.0);
+    assert!(
+        all_late
+            .iter()
+            .all(|&t| (HIGH_NOISE_FROM..DIFFUSION_STEPS).contains(&t))
+    );
+    let uniform = draws(0.0);
+    let late = |ts: &[usize]| ts.iter().filter(|&&t| t >= HIGH_NOISE_FROM).count() as f64;
+    // A third drawn late plus the uniform tenth: ~40 % at t ≥ 900, against ~10 %.
+    let mixed = draws(1.0 / 3.0);
+    let n = mixed.len() as f64;
+    assert!(
+        (late(&mixed) / n - 0.4).abs() < 0.08,
+        "{}",
+        late(&mixed) / n
+    );
+    assert!(late(&uniform) / n < 0.2, "{}", late(&uniform) / n);
+    // Share 0 is the draw runs made before the option: the same generator calls.
+    let cfg = TrainConfig {
+        batch_size: 64,
+        crop_frames: 16,
+        ..TrainConfig::default()
+    };
+    let batch = draw_batch(&data, &clips, &cfg, 3);
+    let mut rng = step_rng(cfg.seed, 3);
+    for _ in 0..cfg.batch_size {
+        let _ = rng.random_range(0..1usize); // the clip (one clip: a plain range draw)
+        let _ = rng.random_range(0..=data.index.clips[0].frames - 16); // its crop
+        let _ = rng.random_range(0..1usize); // its caption
+    }
+    let want: Vec<usize> = (0..cfg.batch_size)
+        .map(|_| rng.random_range(0..DIFFUSION_STEPS))
+        .collect();
+    assert_eq!(batch.timesteps, want);
+}

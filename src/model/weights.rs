@@ -330,11 +330,11 @@ fn load_prompt_encoder(
     let captions_path = dir.join("captions.safetensors");
     let captions = CaptionIndex::load(&captions_path, device)
         .map_err(|e| mismatch(&captions_path, e.to_string()))?;
-    Ok(PromptEncoder::Sentences(Box::new(SentencePrompts {
-        encoder: std::sync::Arc::new(encoder),
+    Ok(PromptEncoder::Sentences(Box::new(SentencePrompts::new(
+        std::sync::Arc::new(encoder),
         captions,
-        lengths: CaptionLengths::load(dir)?,
-    })))
+        CaptionLengths::load(dir)?,
+    ))))
 }
 
 /// The sentence encoder folder for a bundle: `<dir>/text-encoder`, `<dir>/../text-encoder`,

@@ -361,6 +361,20 @@ impl ZipNest {
         }
         Some(runs.div_ceil(4 * rayon::current_num_threads().max(1)).max(1))
     }
+
+    /// Elements per rayon task when the nest is one long run (a strided view such as a
+    /// channel narrowed out of `[.., 3]`, against a broadcast scalar) worth splitting;
+    /// None otherwise. `runs_per_task` cannot split it: it has a single run.
+    #[cfg(feature = "rayon")]
+    fn single_run_per_task(&self) -> Option<usize> {
+        if self.ndim != 1 || self.shape[0] < crate::ops::par::PAR_MIN_ELEMS {
+            return None;
+        }
+        if self.lhs_strides[0] < 0 || self.rhs_strides[0] < 0 {
+            return None;
+        }
+        Some(self.shape[0].div_ceil(4 * rayon::current_num_threads().max(1)))
+    }
 }
 
 /// One run of `len` elements: `out[j] = op(lhs[lb + j·ls], rhs[rb + j·rs])`, written
@@ -440,6 +454,22 @@ where
             });
         return;
     }
+    #[cfg(feature = "rayon")]
+    if let Some(per) = nest.single_run_per_task() {
+        use rayon::prelude::*;
+        let (len, _, r_st) = nest.inner();
+        let (base, rb) = (nest.lhs_offset, nest.rhs_offset);
+        dst[base..base + len]
+            .par_chunks_mut(per)
+            .enumerate()
+            .for_each(|(i, chunk)| {
+                let start = i * per;
+                for (j, d) in chunk.iter_mut().enumerate() {
+                    *d = op(*d, src[rb + (start + j) * r_st as usize]);
+                }
+            });
+        return;
+    }
     zip_apply_inplace(nest, dst, src, op)
 }
 
@@ -478,6 +508,23 @@ where
                 });
             // Safety: the chunks cover 0..total and every run wrote each of its elements.
             unsafe { out.set_len(total) };
+            return Some(out);
+        }
+        if let Some(per) = nest.single_run_per_task() {
+            use rayon::prelude::*;
+            let (len, l_st, r_st) = nest.inner();
+            let (lb, rb) = (nest.lhs_offset, nest.rhs_offset);
+            let mut out: Vec<Out> = Vec::with_capacity(len);
+            out.spare_capacity_mut()[..len]
+                .par_chunks_mut(per)
+                .enumerate()
+                .for_each(|(i, chunk)| {
+                    let start = i * per;
+                    let at = |base: usize, st: isize| base + start * st as usize;
+                    zip_run(chunk, lhs, rhs, (at(lb, l_st), l_st), (at(rb, r_st), r_st), &op);
+                });
+            // Safety: the chunks cover 0..len and zip_run wrote each of their elements.
+            unsafe { out.set_len(len) };
             return Some(out);
         }
     }

@@ -15,7 +15,7 @@ mod unicode_tables;
 mod tests;
 
 pub use bert::{Bert, BertConfig};
-pub use nearest::{CaptionIndex, FAR_COSINE, Nearest};
+pub use nearest::{CaptionIndex, FAR_COSINE, NEIGHBOUR_MARGIN, Nearest, SNAP_COSINE, Snapped};
 pub use normalize::basic_tokens;
 pub use tokenizer::{MAX_TOKENS, WordPiece};
 

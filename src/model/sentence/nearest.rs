@@ -17,6 +17,26 @@ use std::path::Path;
 /// unrelated text 0.32 at most, motions outside the data 0.32–0.55.
 pub const FAR_COSINE: f32 = 0.5;
 
+/// Below this best cosine a prompt is not given to the model as written: it is replaced by
+/// the mean of its nearest captions (see [`CaptionIndex::snap`]). Between `FAR_COSINE` and
+/// here lie paraphrases the model has never read ("a person hurries": best 0.56, a walk);
+/// their raw vectors sit off the few hundred points the denoiser was trained on, and it
+/// answers them with a standing pose instead of what their neighbours do.
+pub const SNAP_COSINE: f32 = 0.7;
+
+/// Captions this close to a prompt's best cosine are its neighbours (the length prior's and
+/// snapping's rule).
+pub const NEIGHBOUR_MARGIN: f32 = 0.05;
+
+/// A prompt replaced by its neighbours.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapped {
+    /// The prompt's best cosine with a training caption.
+    pub best: f32,
+    /// The neighbours whose mean vector stands in for the prompt, nearest first.
+    pub neighbours: Vec<String>,
+}
+
 /// The closest caption and its cosine.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Nearest {
@@ -97,6 +117,67 @@ impl CaptionIndex {
             .into_data()
             .try_to_vec_as::<f32>()
             .expect("float tensors read back as f32")
+    }
+
+    /// Each row of `vectors` (`[B, dim]` unit prompt vectors) whose best cosine with a
+    /// caption is below `below`, replaced by the normalised mean of its neighbours' vectors
+    /// (the captions within [`NEIGHBOUR_MARGIN`] of the best); rows at or above it, and
+    /// every row when the index is empty, are returned unchanged. The model is then
+    /// conditioned on a point it was trained on, so an unseen paraphrase does what its
+    /// neighbours do.
+    pub fn snap(&self, vectors: Tensor<2>, below: f32) -> (Tensor<2>, Vec<Option<Snapped>>) {
+        let [b, dim] = vectors.dims();
+        if self.captions.is_empty() || b == 0 {
+            return (vectors, vec![None; b]);
+        }
+        let n = self.captions.len();
+        let device = vectors.device();
+        let sims = vectors
+            .clone()
+            .matmul(self.embeddings.clone().to_device(&device).transpose())
+            .into_data()
+            .try_to_vec_as::<f32>()
+            .expect("float tensors read back as f32");
+        let mut rows = vectors
+            .to_data()
+            .try_to_vec_as::<f32>()
+            .expect("float tensors read back as f32");
+        let mut table: Option<Vec<f32>> = None;
+        let mut report = Vec::with_capacity(b);
+        for (i, row_sims) in sims.chunks_exact(n).enumerate() {
+            let best = row_sims.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            if best >= below {
+                report.push(None);
+                continue;
+            }
+            let mut near: Vec<usize> = (0..n)
+                .filter(|&c| row_sims[c] >= best - NEIGHBOUR_MARGIN)
+                .collect();
+            near.sort_by(|&a, &c| row_sims[c].total_cmp(&row_sims[a]));
+            let table = table.get_or_insert_with(|| {
+                self.embeddings
+                    .to_data()
+                    .try_to_vec_as::<f32>()
+                    .expect("float tensors read back as f32")
+            });
+            let row = &mut rows[i * dim..(i + 1) * dim];
+            row.fill(0.0);
+            for &c in &near {
+                for (r, e) in row.iter_mut().zip(&table[c * dim..(c + 1) * dim]) {
+                    *r += e;
+                }
+            }
+            let norm = row.iter().map(|v| v * v).sum::<f32>().sqrt().max(1e-12);
+            row.iter_mut().for_each(|v| *v /= norm);
+            report.push(Some(Snapped {
+                best,
+                neighbours: near.iter().map(|&c| self.captions[c].clone()).collect(),
+            }));
+        }
+        (
+            Tensor::from_data(TensorData::new(rows, [b, dim]), &device),
+            report,
+        )
     }
 
     /// Writes the index as SafeTensors (f16).

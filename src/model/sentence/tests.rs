@@ -188,3 +188,42 @@ fn caption_index_round_trips_through_its_file() {
         "{e}"
     );
 }
+
+#[test]
+fn far_prompts_snap_to_the_mean_of_their_neighbours() {
+    let captions = [
+        "a person walks forward",
+        "a person walks forward quickly",
+        "a person raises both hands",
+        "a person kicks",
+    ];
+    let index = CaptionIndex::build(encoder(), &captions);
+    let prompts = ["a person walks forward", "a person hurries"];
+    let vectors = encoder().encode(&prompts);
+    let before = rows(vectors.clone());
+    let (snapped, report) = index.snap(vectors, SNAP_COSINE);
+    let after = rows(snapped);
+    // A training caption is read as written.
+    assert_eq!(report[0], None);
+    assert_eq!(after[0], before[0]);
+    // A far paraphrase becomes the normalised mean of its neighbours' vectors.
+    let s = report[1]
+        .clone()
+        .expect("\"a person hurries\" is far from every caption");
+    assert!(s.best < SNAP_COSINE, "{s:?}");
+    assert!(s.neighbours.iter().all(|n| n.contains("walks")), "{s:?}");
+    let table = rows(index.embeddings().clone());
+    let mut mean = vec![0.0f32; after[1].len()];
+    for n in &s.neighbours {
+        let i = index.captions().iter().position(|c| c == n).unwrap();
+        mean.iter_mut().zip(&table[i]).for_each(|(m, e)| *m += e);
+    }
+    let norm = mean.iter().map(|v| v * v).sum::<f32>().sqrt();
+    for (a, m) in after[1].iter().zip(&mean) {
+        assert!((a - m / norm).abs() < 1e-5);
+    }
+    // Threshold 0 (`--literal-prompt`) reads every prompt as written.
+    let (literal, report) = index.snap(encoder().encode(&prompts), 0.0);
+    assert!(report.iter().all(Option::is_none));
+    assert_eq!(rows(literal), before);
+}

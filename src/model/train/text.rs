@@ -43,11 +43,7 @@ impl TrainText {
             .map(|(i, c)| (c.clone(), i))
             .collect();
         TrainText::Sentences {
-            prompts: Box::new(SentencePrompts {
-                encoder,
-                captions,
-                lengths,
-            }),
+            prompts: Box::new(SentencePrompts::new(encoder, captions, lengths)),
             rows,
         }
     }
