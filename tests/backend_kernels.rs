@@ -4,7 +4,7 @@
 //! rayon pool), on a uniquely owned tensor (computed in place) and a shared one.
 
 use burn::tensor::activation::{gelu, softmax};
-use burn::tensor::{Device, Tensor, TensorData};
+use burn::tensor::{Device, Int, Tensor, TensorData};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -402,4 +402,45 @@ fn one_long_strided_run_splits_exactly() {
     let unique = Tensor::<4>::from_data(TensorData::new(w.clone(), [b, n, j, 1]), &device);
     let got = flat(unique * x);
     assert!((0..rows).all(|k| got[k] == w[k] * v[k * 3]));
+}
+
+#[test]
+fn row_selects_and_column_cats_are_exact() {
+    // A select of joint rows from `[B, rows, 3]` (3-element slices, the short-slice path)
+    // and of 12-element rows (the bulk path), and a cat of three `[B, F, 1]` columns
+    // along the last dim (one-element chunks).
+    let device = Device::flex();
+    // The last case is a batch of 32 motions (the parallel path, one task per motion).
+    for (b, rows, width, count) in [(5, 40, 3usize, 5usize), (5, 40, 12, 5), (32, 2112, 3, 700)] {
+        let v = random(b * rows * width, -1.0, 1.0, 41);
+        let t = Tensor::<3>::from_data(TensorData::new(v.clone(), [b, rows, width]), &device);
+        let picks: Vec<i64> = (0..count).map(|k| ((k * 7 + 3) % rows) as i64).collect();
+        let idx = Tensor::<1, Int>::from_data(TensorData::new(picks.clone(), [count]), &device);
+        let got = t.select(1, idx).into_data().try_into_vec::<f32>().unwrap();
+        let want: Vec<f32> = (0..b)
+            .flat_map(|s| {
+                let v = &v;
+                picks.iter().flat_map(move |&r| {
+                    let at = (s * rows + r as usize) * width;
+                    v[at..at + width].iter().copied()
+                })
+            })
+            .collect();
+        assert_eq!(got, want, "width {width}");
+    }
+    let (b, f) = (5, 9);
+    let cols: Vec<Vec<f32>> = (0..3).map(|c| random(b * f, -1.0, 1.0, 50 + c)).collect();
+    let parts: Vec<Tensor<3>> = cols
+        .iter()
+        .map(|c| Tensor::from_data(TensorData::new(c.clone(), [b, f, 1]), &device))
+        .collect();
+    let got = Tensor::cat(parts, 2)
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap();
+    let want: Vec<f32> = (0..b * f)
+        .flat_map(|k| (0..3).map(move |c| (k, c)))
+        .map(|(k, c)| cols[c][k])
+        .collect();
+    assert_eq!(got, want);
 }

@@ -138,13 +138,21 @@ fn far_prompts_are_reported_with_the_nearest_caption() {
     let dev = Device::flex();
     let dir = tempfile::tempdir().unwrap();
     train(dir.path(), sentence_tiny(), None, 1e-3, 5);
-    let bundle = ModelBundle::load(&dir.path().join("bundle"), &dev).unwrap();
-    assert!(bundle.text.report("someone strolls ahead").is_empty());
-    let far = bundle
-        .text
-        .report("the committee approved the annual budget");
-    assert_eq!(far.len(), 1, "{far:?}");
+    let mut bundle = ModelBundle::load(&dir.path().join("bundle"), &dev).unwrap();
+    assert!(bundle.text.report("a person walks forward").is_empty());
+    let budget = "the committee approved the annual budget";
+    let far = bundle.text.report(budget);
+    assert_eq!(far.len(), 2, "{far:?}");
     assert!(far[0].contains("nearest known: \"a person"), "{far:?}");
+    // Read through its neighbours, and told so.
+    assert!(
+        far[1].contains("conditioned on the mean of its nearest captions, \"a person"),
+        "{far:?}"
+    );
+    assert!(bundle.text.snapped(budget).is_some());
+    bundle.text.read_literally();
+    assert_eq!(bundle.text.report(budget).len(), 1);
+    assert!(bundle.text.snapped(budget).is_none());
     assert!(bundle.text.unknown_words("someone moonwalks").is_empty());
 }
 

@@ -79,8 +79,19 @@ struct CachedIndices {
     /// frame, as `for j in joints` over `always` does): the rows themselves, with no
     /// copy forward and no scatter into zeros backward.
     whole: HashSet<NodeId>,
+    /// Every other gather's rows in one index list, and where each gather's rows sit in
+    /// it, when there are two or more: one `select` of the motion, each gather a slice of
+    /// it. Separate selects each scatter their gradient into motion-sized zeros that are
+    /// then summed; sliced, only the merged rows are written back to the motion.
+    merged: Option<MergedGather>,
     consts: HashMap<NodeId, Tensor<4>>,
     domain_sizes: Vec<usize>,
+}
+
+/// The rows of several gathers as one index list, and each gather's (start, length) in it.
+struct MergedGather {
+    rows: Tensor<1, Int>,
+    slices: HashMap<NodeId, (usize, usize)>,
 }
 
 impl Clone for IndexCache {
@@ -95,12 +106,23 @@ impl std::fmt::Debug for IndexCache {
     }
 }
 
-/// The rows gather `node` reads: `rows` itself when it reads every row in order.
-fn gather_rows(rows: &Tensor<3>, idx: &CachedIndices, node: NodeId) -> Tensor<3> {
+/// The rows gather `node` reads: `rows` itself when it reads every row in order, a slice
+/// of `merged` (the merged gather's rows) when it is part of it.
+fn gather_rows(
+    rows: &Tensor<3>,
+    merged: Option<&Tensor<3>>,
+    idx: &CachedIndices,
+    node: NodeId,
+) -> Tensor<3> {
     if idx.whole.contains(&node) {
-        rows.clone()
-    } else {
-        rows.clone().select(1, idx.gathers[&node].clone())
+        return rows.clone();
+    }
+    match (merged, &idx.merged) {
+        (Some(all), Some(m)) if m.slices.contains_key(&node) => {
+            let (start, len) = m.slices[&node];
+            all.clone().narrow(1, start, len)
+        }
+        _ => rows.clone().select(1, idx.gathers[&node].clone()),
     }
 }
 
@@ -116,6 +138,7 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
     let mut gathers = HashMap::new();
     let mut whole = HashSet::new();
     let mut consts = HashMap::new();
+    let mut parts: Vec<(NodeId, Vec<i64>)> = Vec::new();
     let rows = ir.people * frames * NUM_JOINTS;
     for (i, node) in ir.nodes.iter().enumerate() {
         if let Op::Const(v) = &node.op {
@@ -150,16 +173,33 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
         if n == rows && idx.iter().enumerate().all(|(k, &r)| r == k as i64) {
             whole.insert(i);
         }
+        if !whole.contains(&i) {
+            parts.push((i, idx.clone()));
+        }
         gathers.insert(
             i,
             Tensor::<1, Int>::from_data(TensorData::new(idx, [n]), device),
         );
     }
+    let merged = (parts.len() >= 2).then(|| {
+        let mut at = HashMap::new();
+        let mut all = Vec::new();
+        for (node, idx) in parts {
+            at.insert(node, (all.len(), idx.len()));
+            all.extend(idx);
+        }
+        let n = all.len();
+        MergedGather {
+            rows: Tensor::<1, Int>::from_data(TensorData::new(all, [n]), device),
+            slices: at,
+        }
+    });
     CachedIndices {
         frames,
         device: device.clone(),
         gathers,
         whole,
+        merged,
         consts,
         domain_sizes,
     }
@@ -213,6 +253,10 @@ fn with_node_values<T>(
     };
     // [batch, people·frames·22, 3]
     let rows = joints.reshape([batch, people * frames * NUM_JOINTS, 3]);
+    let merged = idx
+        .merged
+        .as_ref()
+        .map(|m| rows.clone().select(1, m.rows.clone()));
     let mut values: Vec<Option<Tensor<4>>> = vec![None; ir.nodes.len()];
     let last_use = last_uses(ir);
     for (i, node) in ir.nodes.iter().enumerate() {
@@ -227,11 +271,11 @@ fn with_node_values<T>(
             Op::Const(_) => idx.consts[&i].clone(),
             Op::Gather { .. } => {
                 // [batch, |D|·K, 3] → [batch, |D|, K, 3]
-                let g = gather_rows(&rows, idx, i);
+                let g = gather_rows(&rows, merged.as_ref(), idx, i);
                 g.reshape([batch, frames_of(node), node.lanes, 3])
             }
             Op::MassCenter { weights, .. } => {
-                let g = gather_rows(&rows, idx, i);
+                let g = gather_rows(&rows, merged.as_ref(), idx, i);
                 // [batch, |D|, K, 22, 3] weighted over joints → [batch, |D|, K, 3]
                 let g: Tensor<5> = g.reshape([batch, frames_of(node), node.lanes, NUM_JOINTS, 3]);
                 let w =

@@ -100,16 +100,27 @@ fn cat_impl<E: Element + bytemuck::Pod>(tensors: Vec<FlexTensor>, dim: usize) ->
         // Make all tensors contiguous for simple indexing
         let contiguous: Vec<FlexTensor> = tensors.into_iter().map(|t| t.to_contiguous()).collect();
 
-        for outer in 0..outer_size {
-            for t in &contiguous {
+        // mprog patch: each input's storage and chunk length looked up once, not once per
+        // outer index (a cat of `[.., 1]` columns along the last dim, as an `[x, y, z]`
+        // vector is built, did a storage lookup and a one-element copy per row), and
+        // one-element chunks pushed without a memmove call.
+        let parts: Vec<(&[E], usize)> = contiguous
+            .iter()
+            .map(|t| {
                 let data: &[E] = t.storage();
-                let t_dim_size = t.layout().shape()[dim];
-                let t_start = t.layout().start_offset();
-                // Each tensor's chunk for this outer index:
-                // offset = t_start + outer * t_dim_size * inner_size
-                let chunk_start = t_start + outer * t_dim_size * inner_size;
-                let chunk_len = t_dim_size * inner_size;
-                output.extend_from_slice(&data[chunk_start..chunk_start + chunk_len]);
+                let chunk_len = t.layout().shape()[dim] * inner_size;
+                (&data[t.layout().start_offset()..], chunk_len)
+            })
+            .collect();
+        for outer in 0..outer_size {
+            for &(data, chunk_len) in &parts {
+                // Each tensor's chunk for this outer index starts at outer * chunk_len.
+                let chunk_start = outer * chunk_len;
+                if chunk_len == 1 {
+                    output.push(data[chunk_start]);
+                } else {
+                    output.extend_from_slice(&data[chunk_start..chunk_start + chunk_len]);
+                }
             }
         }
     }

@@ -774,8 +774,6 @@ pub fn select<E: Element + Pod + Default + Copy + Send + Sync>(
     }
 
     // Use bulk copies for contiguous slices
-    let mut result = vec![E::default(); output_size];
-
     // For each position in dimensions before `dim`
     let outer_count = if dim == 0 {
         1
@@ -783,18 +781,53 @@ pub fn select<E: Element + Pod + Default + Copy + Send + Sync>(
         tensor_shape[..dim].iter().product()
     };
 
+    // mprog patch: the output is written in order (outer, index, slice), so it is pushed
+    // instead of zero-filled and then overwritten, and short slices (the 3 coordinates of
+    // a joint row) are copied element by element instead of by a memmove call each.
+    let per_outer = indices_data.len() * slice_size;
+    #[cfg(feature = "rayon")]
+    if outer_count >= 2 && output_size >= crate::ops::par::PAR_MIN_ELEMS {
+        // Each outer index (each motion of a batch) fills its own block of the output.
+        let mut result: Vec<E> = Vec::with_capacity(output_size);
+        let outer_stride = tensor_strides[if dim == 0 { 0 } else { dim - 1 }];
+        result.spare_capacity_mut()[..output_size]
+            .par_chunks_mut(per_outer)
+            .enumerate()
+            .for_each(|(outer, block)| {
+                let mut k = 0;
+                for &idx in indices_data.iter() {
+                    let index_val = checked_index(idx, select_dim_size);
+                    let src_start = outer * outer_stride + index_val * tensor_strides[dim];
+                    for &v in &tensor_data[src_start..src_start + slice_size] {
+                        block[k] = core::mem::MaybeUninit::new(v);
+                        k += 1;
+                    }
+                }
+            });
+        // Safety: the blocks cover 0..output_size and each wrote all of its elements.
+        unsafe { result.set_len(output_size) };
+        let bytes = Bytes::from_elems(result);
+        return FlexTensor::new(bytes, Layout::contiguous(output_shape), E::dtype());
+    }
+    let _ = per_outer;
+    let mut result: Vec<E> = Vec::with_capacity(output_size);
     for outer in 0..outer_count {
         let outer_offset_tensor = outer * tensor_strides[if dim == 0 { 0 } else { dim - 1 }];
-        let outer_offset_output = outer * output_strides[if dim == 0 { 0 } else { dim - 1 }];
 
-        for (i, &idx) in indices_data.iter().enumerate() {
+        for &idx in indices_data.iter() {
             let index_val = checked_index(idx, select_dim_size);
             let src_start = outer_offset_tensor + index_val * tensor_strides[dim];
-            let dst_start = outer_offset_output + i * output_strides[dim];
-            result[dst_start..dst_start + slice_size]
-                .copy_from_slice(&tensor_data[src_start..src_start + slice_size]);
+            let src = &tensor_data[src_start..src_start + slice_size];
+            if slice_size <= 8 {
+                for &v in src {
+                    result.push(v);
+                }
+            } else {
+                result.extend_from_slice(src);
+            }
         }
     }
+    debug_assert_eq!(result.len(), output_size);
 
     let bytes = Bytes::from_elems(result);
     FlexTensor::new(bytes, Layout::contiguous(output_shape), E::dtype())
