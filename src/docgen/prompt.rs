@@ -178,7 +178,8 @@ fn actions_section(actions: &[(String, usize)]) -> String {
          (training clips in brackets; style words such as \"tired\", \"happy\" or \"old\" combine\n\
          with the walks, runs, waves and hand raises). Prompt one of them, or a plain\n\
          paraphrase; for anything else let the constraints carry the motion. `mprog check`\n\
-         warns when a prompt is far from all of them.\n\n",
+         warns when a prompt is far from all of them, and a prompt unlike every one of them\n\
+         is read as the mean of its nearest ones (`mprog run` says which).\n\n",
     );
     for (caption, n) in listed {
         s.push_str(&format!("- {caption} ({n})\n"));
