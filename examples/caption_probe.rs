@@ -17,10 +17,12 @@ use mprog::model::noise::NoiseSource;
 use mprog::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use std::path::PathBuf;
 
-/// Highest ankle (m) and highest lowest-foot-joint (both feet up, m) of a feature clip.
+/// Highest ankle (m) and highest lowest-foot-joint (both feet up, m) of a feature clip,
+/// both above the clip's lowest foot joint.
 fn heights(raw: &[f32]) -> (f32, f32) {
     let m = recover_from_ric(raw).expect("feature rows");
-    let floor = m
+    // Per frame: the lowest of the four foot joints.
+    let lowest_foot: Vec<f32> = m
         .frames
         .iter()
         .map(|f| {
@@ -29,21 +31,13 @@ fn heights(raw: &[f32]) -> (f32, f32) {
                 .map(|&j| f[j].y)
                 .fold(f32::MAX, f32::min)
         })
-        .fold(f32::MAX, f32::min);
+        .collect();
+    let floor = lowest_foot.iter().copied().fold(f32::MAX, f32::min);
+    let both = lowest_foot.iter().copied().fold(f32::MIN, f32::max);
     let ankle = m
         .frames
         .iter()
         .map(|f| f[7].y.max(f[8].y))
-        .fold(f32::MIN, f32::max);
-    let both = m
-        .frames
-        .iter()
-        .map(|f| {
-            [7, 8, 10, 11]
-                .iter()
-                .map(|&j| f[j].y)
-                .fold(f32::MAX, f32::min)
-        })
         .fold(f32::MIN, f32::max);
     (ankle - floor, both - floor)
 }
