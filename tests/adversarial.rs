@@ -174,6 +174,7 @@ fn tiny_config() -> ModelConfig {
         text_encoder: Default::default(),
         max_frames: 40,
         input_skip: false,
+        skip_taps: 1,
     }
 }
 

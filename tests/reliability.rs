@@ -44,6 +44,7 @@ fn model_config(d_model: usize, layers: usize) -> ModelConfig {
         text_encoder: Default::default(),
         max_frames: 40,
         input_skip: false,
+        skip_taps: 1,
     }
 }
 

@@ -255,6 +255,7 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
         text_encoder: Default::default(),
         max_frames: 50,
         input_skip: false,
+        skip_taps: 1,
         ..ModelConfig::default()
     };
     let vocab = Vocabulary::from_captions(

@@ -34,6 +34,14 @@ pub struct ModelConfig {
     /// columns (the root's yaw rate) badly. Bundles without it load as before.
     #[serde(default, skip_serializing_if = "is_false")]
     pub input_skip: bool,
+    /// Frames the input skip reads around each frame (odd; 1 = the frame alone). With more,
+    /// the skip is a timestep-gated temporal filter, `Σ_k g_k(t) ⊙ x_t[n + k − K/2]` (edges
+    /// repeat the first and last valid frame): the attention layers copy a frame's own
+    /// noise badly, and a 9-tap linear filter alone beats the trained transformer's x̂0
+    /// at t ≤ 200 (book, model chapter, "Jitter and stretched bones"). Bundles without the
+    /// field have 1.
+    #[serde(default = "one_tap", skip_serializing_if = "is_one_tap")]
+    pub skip_taps: usize,
 }
 
 /// The text encoder of a denoiser.
@@ -59,6 +67,14 @@ fn is_false(b: &bool) -> bool {
     !*b
 }
 
+fn one_tap() -> usize {
+    1
+}
+
+fn is_one_tap(v: &usize) -> bool {
+    *v == 1
+}
+
 fn default_features() -> usize {
     263
 }
@@ -79,6 +95,7 @@ impl Default for ModelConfig {
             text_encoder: TextEncoderKind::BagOfWords,
             max_frames: 196,
             input_skip: false,
+            skip_taps: 1,
         }
     }
 }
@@ -118,6 +135,11 @@ pub struct TrainConfig {
     /// Weight of the bone-length loss on the predicted pose, in cm² per bone (0 disables).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub bone_loss: f64,
+    /// Weigh each clip's bone-length term by its signal fraction ᾱ_t: at large t x̂0 is the
+    /// mean of many poses, whose bones are rightly shorter, and only near the end of the
+    /// chain must the pose be one body.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub bone_loss_by_signal: bool,
     /// Weight of an extra x0 MSE on the 4 root columns (yaw velocity, XZ velocity,
     /// height), averaged over those columns alone: the base MSE gives each of them 1/263
     /// of the loss, and a turn is the integral of the yaw velocity over the clip, so a
@@ -147,6 +169,15 @@ pub struct TrainConfig {
     /// time.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub high_noise_fraction: f64,
+    /// Timestep t₀ under which each clip's x0 MSE is weighed up by `(1−ᾱ_t₀)/(1−ᾱ_t)`, at
+    /// most [`Self::low_noise_loss_cap`]: the x0 MSE of a small t is the square of a small
+    /// noise, so unweighted the last steps of the chain, where a sample's jitter is taken
+    /// out, hardly count (0: off).
+    #[serde(default, skip_serializing_if = "is_zero_usize")]
+    pub low_noise_below: usize,
+    /// Largest weight of [`Self::low_noise_below`].
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub low_noise_loss_cap: f64,
     /// Seed of the data order and noise.
     pub seed: u64,
 }
@@ -168,14 +199,21 @@ impl Default for TrainConfig {
             foot_loss: 0.0,
             velocity_loss: 0.0,
             bone_loss: 0.0,
+            bone_loss_by_signal: false,
             root_loss: 0.0,
             word_drop: 0.0,
             source_weights: Default::default(),
             loss_per_clip: false,
             high_noise_fraction: 0.0,
+            low_noise_below: 0,
+            low_noise_loss_cap: 0.0,
             seed: 1,
         }
     }
+}
+
+fn is_zero_usize(v: &usize) -> bool {
+    *v == 0
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -185,6 +223,9 @@ fn is_zero(v: &f64) -> bool {
 /// Largest accepted layer width, head count, layer count, … of a configuration: far above
 /// anything that trains on a CPU, low enough that a typo cannot ask for terabytes.
 const MAX_SIZE: usize = 1 << 16;
+
+/// Most frames the input skip may read around a frame.
+const MAX_SKIP_TAPS: usize = 31;
 
 fn in_range(name: &str, value: usize, lo: usize, hi: usize) -> Result<(), String> {
     if (lo..=hi).contains(&value) {
@@ -220,6 +261,13 @@ impl ModelConfig {
         in_range("d_ff", self.d_ff, 1, MAX_SIZE)?;
         in_range("d_text", self.d_text, 1, MAX_SIZE)?;
         in_range("max_frames", self.max_frames, 2, MAX_SIZE)?;
+        in_range("skip_taps", self.skip_taps, 1, MAX_SKIP_TAPS)?;
+        if self.skip_taps.is_multiple_of(2) {
+            return Err(format!("`skip_taps` ({}) must be odd", self.skip_taps));
+        }
+        if self.skip_taps > 1 && !self.input_skip {
+            return Err("`skip_taps` above 1 needs `input_skip = true`".into());
+        }
         fraction("dropout", self.dropout, true)
     }
 }
@@ -245,6 +293,7 @@ impl TrainConfig {
             ("velocity_loss", self.velocity_loss),
             ("bone_loss", self.bone_loss),
             ("root_loss", self.root_loss),
+            ("low_noise_loss_cap", self.low_noise_loss_cap),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("`{name}` is {v}; it must be zero or positive"));
@@ -260,6 +309,18 @@ impl TrainConfig {
         fraction("cond_drop", self.cond_drop, false)?;
         fraction("word_drop", self.word_drop, false)?;
         fraction("high_noise_fraction", self.high_noise_fraction, false)?;
+        in_range(
+            "low_noise_below",
+            self.low_noise_below,
+            0,
+            crate::model::schedule::DIFFUSION_STEPS - 1,
+        )?;
+        if self.low_noise_below > 0 && self.low_noise_loss_cap < 1.0 {
+            return Err(format!(
+                "`low_noise_loss_cap` is {}; with `low_noise_below` it must be at least 1",
+                self.low_noise_loss_cap
+            ));
+        }
         fraction("ema_decay", self.ema_decay, true)
     }
 }

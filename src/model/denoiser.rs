@@ -51,6 +51,8 @@ pub struct Mdm {
     skip: Option<Linear>,
     dropout: Dropout,
     d_model: usize,
+    /// Frames the input skip reads around each frame ([`ModelConfig::skip_taps`]).
+    skip_taps: usize,
 }
 
 /// A `d → features` linear layer that starts at zero (weights and bias).
@@ -93,10 +95,47 @@ impl Mdm {
             output_proj: LinearConfig::new(d, config.features).init(device),
             skip: config
                 .input_skip
-                .then(|| zero_skip(d, config.features, device)),
+                .then(|| zero_skip(d, config.features * config.skip_taps, device)),
             dropout: DropoutConfig::new(config.dropout).init(),
             d_model: d,
+            skip_taps: config.skip_taps,
         }
+    }
+
+    /// This denoiser with its input skip reading `taps` frames instead of one: the one-frame
+    /// gain becomes the centre tap and the others start at zero, so it predicts the same.
+    /// Already wider, or without a skip: unchanged.
+    pub fn with_skip_taps(mut self, taps: usize) -> Self {
+        let Some(skip) = self.skip.take() else {
+            return self;
+        };
+        if self.skip_taps != 1 || taps <= 1 {
+            self.skip = Some(skip);
+            return self;
+        }
+        let device = skip.weight.device();
+        let [d, f] = skip.weight.dims();
+        let centre = taps / 2;
+        let widen = |t: Tensor<2>| {
+            let rows = t.dims()[0];
+            let mut blocks = vec![Tensor::<2>::zeros([rows, f], &device); taps];
+            blocks[centre] = t;
+            Tensor::cat(blocks, 1)
+        };
+        let weight = widen(skip.weight.val());
+        let bias = skip
+            .bias
+            .as_ref()
+            .map(|b| widen(b.val().reshape([1, f])).reshape([f * taps]));
+        // Fresh leaf parameters (the widened values are built from the old ones).
+        let mut wide = zero_skip(d, f * taps, &device);
+        wide.weight = burn::module::Param::from_tensor(weight.detach());
+        if let Some(bias) = bias {
+            wide.bias = Some(burn::module::Param::from_tensor(bias.detach()));
+        }
+        self.skip = Some(wide);
+        self.skip_taps = taps;
+        self
     }
 
     /// This denoiser with a zero input skip added (no change to what it predicts), so a
@@ -104,12 +143,13 @@ impl Mdm {
     pub fn with_input_skip(mut self, device: &Device) -> Self {
         if self.skip.is_none() {
             let features = self.output_proj.weight.dims()[1];
-            self.skip = Some(zero_skip(self.d_model, features, device));
+            self.skip = Some(zero_skip(self.d_model, features * self.skip_taps, device));
         }
         self
     }
 
-    /// The input skip's per-feature gain at timestep `t` (None without `input_skip`).
+    /// The input skip's per-feature gain at timestep `t` (None without `input_skip`); with
+    /// several taps, K·F values, tap by tap (the centre tap reads the frame itself).
     pub fn input_skip_gain(&self, t: usize) -> Option<Vec<f32>> {
         let skip = self.skip.as_ref()?;
         let device = skip.weight.device();
@@ -161,13 +201,58 @@ impl Mdm {
         let n = input.x_t.dims()[1];
         let out = self.output_proj.forward(out.narrow(1, 1, n)); // [B, N, F]
         match &self.skip {
-            Some(skip) => {
+            Some(skip) if self.skip_taps == 1 => {
                 let t = sinusoids(input.timesteps.iter().copied(), self.d_model, &device);
                 let gain = skip.forward(t).unsqueeze_dim::<3>(1); // [B, 1, F]
                 out + gain * input.x_t.clone()
             }
+            Some(skip) => out + self.filtered_skip(skip, input),
             None => out,
         }
+    }
+
+    /// The input skip with [`ModelConfig::skip_taps`] K > 1: `Σ_k g_k(t) ⊙ x_t[n + k − K/2]`,
+    /// each sample's frames clamped to its valid ones (padding is never read), `[B, N, F]`.
+    fn filtered_skip(&self, skip: &Linear, input: &DenoiserInput) -> Tensor<3> {
+        let device = input.x_t.device();
+        let [b, n, f] = input.x_t.dims();
+        let k = self.skip_taps;
+        let valid: Vec<usize> = match &input.padding {
+            Some(pad) => pad
+                .clone()
+                .into_data()
+                .iter::<bool>()
+                .collect::<Vec<_>>()
+                .chunks(n)
+                .map(|row| row.iter().filter(|&&p| !p).count().max(1))
+                .collect(),
+            None => vec![n; b],
+        };
+        // Row of x_t (flattened to [B·N, F]) each tap reads, tap-major: [K·B·N].
+        let mut rows = Vec::with_capacity(k * b * n);
+        for tap in 0..k {
+            for (s, &len) in valid.iter().enumerate() {
+                for frame in 0..n {
+                    let at = (frame + tap).saturating_sub(k / 2).min(len - 1);
+                    rows.push((s * n + at) as i64);
+                }
+            }
+        }
+        let rows = Tensor::<1, Int>::from_data(TensorData::new(rows, [k * b * n]), &device);
+        let taps = input
+            .x_t
+            .clone()
+            .reshape([b * n, f])
+            .select(0, rows)
+            .reshape([k, b, n, f]);
+        let t = sinusoids(input.timesteps.iter().copied(), self.d_model, &device);
+        // [B, K·F] tap-major → [K, B, 1, F].
+        let gains = skip
+            .forward(t)
+            .reshape([b, k, f])
+            .swap_dims(0, 1)
+            .unsqueeze_dim::<4>(2);
+        (taps * gains).sum_dim(0).reshape([b, n, f])
     }
 }
 
@@ -180,5 +265,102 @@ impl Denoiser for Mdm {
         }
         let out = self.encoder.forward(enc_in); // [B, N+1, d]
         self.output(out, input)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::noise::NoiseSource;
+    use crate::model::text::{TokenBatch, Vocabulary};
+
+    fn input(frames: usize, valid: &[usize], dev: &Device) -> DenoiserInput {
+        let vocab = Vocabulary::from_captions(["a person walks"], 8);
+        let b = valid.len();
+        let pad: Vec<bool> = valid
+            .iter()
+            .flat_map(|&len| (0..frames).map(move |f| f >= len))
+            .collect();
+        DenoiserInput {
+            x_t: NoiseSource::new(4).tensor([b, frames, 263], dev),
+            timesteps: vec![30; b],
+            text: TextBatch::Words(TokenBatch::new(&vocab, &vec!["a person walks"; b], dev)),
+            keep_text: Tensor::ones([b], dev),
+            padding: Some(Tensor::from_data(TensorData::new(pad, [b, frames]), dev)),
+        }
+    }
+
+    fn tiny(taps: usize) -> ModelConfig {
+        ModelConfig {
+            d_model: 16,
+            layers: 1,
+            heads: 2,
+            d_ff: 32,
+            d_text: 8,
+            max_frames: 40,
+            input_skip: true,
+            skip_taps: taps,
+            ..ModelConfig::default()
+        }
+    }
+
+    #[test]
+    fn widening_the_skip_keeps_the_prediction() {
+        let dev = Device::flex();
+        let mut one = Mdm::new(&tiny(1), 8, &dev);
+        // A trained one-frame skip (random, not zero).
+        one.skip = Some(LinearConfig::new(16, 263).init(&dev));
+        let wide = one.clone().with_skip_taps(5);
+        assert_eq!(wide.skip_taps, 5);
+        let (g1, g5) = (
+            one.input_skip_gain(30).unwrap(),
+            wide.input_skip_gain(30).unwrap(),
+        );
+        assert_eq!(
+            &g5[2 * 263..3 * 263],
+            &g1[..],
+            "the centre tap is the old gain"
+        );
+        assert!(
+            g5[..2 * 263]
+                .iter()
+                .chain(&g5[3 * 263..])
+                .all(|&g| g == 0.0)
+        );
+        let inp = input(6, &[6, 4], &dev);
+        let (a, b) = (one.valid().predict_x0(&inp), wide.valid().predict_x0(&inp));
+        // Valid frames only: on padding the wide skip reads the last valid frame.
+        let diff = (a - b).narrow(1, 0, 4).abs().max().into_scalar::<f32>();
+        assert!(diff < 1e-5, "{diff}");
+    }
+
+    #[test]
+    fn a_tap_reads_its_neighbouring_frame_and_never_padding() {
+        let dev = Device::flex();
+        let model = Mdm::new(&tiny(5), 8, &dev);
+        // Only the first tap (two frames back) passes its frame through, gain 1.
+        let mut bias = vec![0.0f32; 5 * 263];
+        bias[..263].fill(1.0);
+        let mut skip = zero_skip(16, 5 * 263, &dev);
+        skip.bias = Some(burn::module::Param::from_tensor(Tensor::from_data(
+            TensorData::new(bias, [5 * 263]),
+            &dev,
+        )));
+        let inp = input(6, &[6, 4], &dev);
+        let got = model.filtered_skip(&skip, &inp);
+        let x = inp.x_t.clone();
+        let row = |t: Tensor<3>, s: usize, f: usize| {
+            t.narrow(0, s, 1)
+                .narrow(1, f, 1)
+                .into_data()
+                .try_to_vec::<f32>()
+                .unwrap()
+        };
+        // Sample 0 (6 valid frames): frame 3 reads frame 1, frame 0 repeats frame 0.
+        assert_eq!(row(got.clone(), 0, 3), row(x.clone(), 0, 1));
+        assert_eq!(row(got.clone(), 0, 0), row(x.clone(), 0, 0));
+        // Sample 1 (4 valid): frame 5 (padding) reads the last valid frame, 3.
+        assert_eq!(row(got.clone(), 1, 5), row(x.clone(), 1, 3));
+        assert_eq!(row(got, 1, 2), row(x, 1, 0));
     }
 }

@@ -179,6 +179,7 @@ mod tests {
             text_encoder: Default::default(),
             max_frames: 40,
             input_skip: false,
+            skip_taps: 1,
         };
         let net = Mdm::new(&cfg, vocab().len(), &dev).valid();
         let (mean, std) = stats();

@@ -25,6 +25,7 @@ pub(super) fn tiny() -> ModelConfig {
         text_encoder: Default::default(),
         max_frames: 40,
         input_skip: false,
+        skip_taps: 1,
     }
 }
 
@@ -369,6 +370,29 @@ fn a_run_with_input_skip_can_start_from_a_bundle_without_it() {
         .run(&|_, _, _| {})
         .unwrap_err();
     assert!(err.to_string().contains("does not match"), "{err}");
+    // The one-frame skip widens to a temporal filter, trains with the low-noise weights,
+    // and resumes.
+    let mut taps = skip.clone();
+    taps.model.skip_taps = 5;
+    taps.low_noise_below = 200;
+    taps.low_noise_loss_cap = 50.0;
+    let fourth = tempfile::tempdir().unwrap();
+    let state = run(fourth.path(), &taps, Some(second.path().join("bundle")), 3)
+        .run(&|_, _, _| {})
+        .unwrap();
+    assert_eq!(state.step, 18, "the bundle's 15 steps carry on");
+    let wide = super::weights::ModelBundle::load(&fourth.path().join("bundle"), &dev).unwrap();
+    assert_eq!(wide.config.skip_taps, 5);
+    let gain = wide.model.input_skip_gain(10).unwrap();
+    assert_eq!(gain.len(), 5 * FEATURE_DIM);
+    assert!(
+        gain[..FEATURE_DIM].iter().any(|g| *g != 0.0),
+        "the outer tap learned nothing"
+    );
+    let state = run(fourth.path(), &taps, None, 2)
+        .run(&|_, _, _| {})
+        .unwrap();
+    assert_eq!(state.step, 20);
 }
 
 /// A hook that leaves `hook.txt` in the run folder.

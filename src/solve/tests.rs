@@ -65,6 +65,7 @@ pub(super) fn tiny_bundle() -> ModelBundle {
         text_encoder: Default::default(),
         max_frames: 40,
         input_skip: false,
+        skip_taps: 1,
     };
     let vocab = Vocabulary::from_captions(["a person walks forward", "a person waves"], 8);
     let model =

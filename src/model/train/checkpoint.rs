@@ -57,8 +57,13 @@ impl TrainRun<'_> {
                 // A bundle without the input skip may start a run with it (added at zero);
                 // one with a learned skip cannot start a run without it.
                 let add_skip = cfg.model.input_skip && !bundle.config.input_skip;
+                // A one-frame skip may widen to several taps (the old gain becomes the
+                // centre tap); a wider one cannot narrow.
+                let widen_skip = (bundle.config.skip_taps == 1 && cfg.model.skip_taps > 1)
+                    .then_some(cfg.model.skip_taps);
                 let as_run = ModelConfig {
                     input_skip: bundle.config.input_skip || cfg.model.input_skip,
+                    skip_taps: widen_skip.unwrap_or(bundle.config.skip_taps),
                     ..bundle.config.clone()
                 };
                 let weights = init.join("model.safetensors");
@@ -102,6 +107,10 @@ impl TrainRun<'_> {
                 if add_skip {
                     model = model.with_input_skip(train_dev);
                     ema = ema.with_input_skip(plain);
+                }
+                if let Some(taps) = widen_skip {
+                    model = model.with_skip_taps(taps);
+                    ema = ema.with_skip_taps(taps);
                 }
                 return Ok(Checkpoint {
                     model,

@@ -226,6 +226,19 @@ impl BoneLoss {
 
     /// The term for a normalised prediction `[B, N, 263]`, `valid` `[B, N, 1]`.
     pub fn term(&self, pred: Tensor<3>, valid: Tensor<3>) -> Tensor<1> {
+        let b = pred.dims()[0];
+        let device = pred.device();
+        self.weighted_term(pred, valid, Tensor::ones([b, 1, 1], &device))
+    }
+
+    /// [`Self::term`] with each clip's squared errors scaled by `weights` `[B, 1, 1]` (the
+    /// mean still over every valid frame of the batch).
+    pub fn weighted_term(
+        &self,
+        pred: Tensor<3>,
+        valid: Tensor<3>,
+        weights: Tensor<3>,
+    ) -> Tensor<1> {
         let [b, n, _] = pred.dims();
         let device = pred.device();
         let cols = POSITION_COLUMNS;
@@ -246,9 +259,29 @@ impl BoneLoss {
             .reshape([b, n, NUM_JOINTS - 1]);
         // sqrt(x + ε): a zero-length bone has no direction, and its gradient stays finite.
         let length = length.add_scalar(1e-6).sqrt();
-        let err = (length - self.lengths.clone()).powi_scalar(2) * valid.clone();
+        let err = (length - self.lengths.clone()).powi_scalar(2) * valid.clone() * weights;
         err.sum() / ((valid.sum() + 1.0) * (NUM_JOINTS - 1) as f32)
     }
+}
+
+/// Each sample's x0-MSE weight under [`TrainConfig::low_noise_below`]: `(1−ᾱ_t0)/(1−ᾱ_t)`
+/// below `t0`, at most `cap`, and 1 from `t0` on (the noise variance of `t0` over `t`'s).
+pub fn low_noise_weights(timesteps: &[usize], t0: usize, cap: f32) -> Vec<f32> {
+    use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+    use std::sync::OnceLock;
+    static ALPHAS: OnceLock<Vec<f64>> = OnceLock::new();
+    let alphas = ALPHAS.get_or_init(|| NoiseSchedule::cosine(DIFFUSION_STEPS).alphas_cumprod);
+    let noise = |t: usize| 1.0 - alphas[t.min(DIFFUSION_STEPS - 1)];
+    timesteps
+        .iter()
+        .map(|&t| {
+            if t >= t0 {
+                1.0
+            } else {
+                ((noise(t0) / noise(t).max(f64::MIN_POSITIVE)) as f32).clamp(1.0, cap.max(1.0))
+            }
+        })
+        .collect()
 }
 
 /// The geometric terms added to the x0 MSE in training (each None when its weight is 0).
@@ -260,10 +293,14 @@ pub struct GeometricLosses {
     pub velocity: Option<VelocityLoss>,
     /// The bone-length term.
     pub bones: Option<BoneLoss>,
+    /// Weigh the bone term of each clip by ᾱ_t ([`TrainConfig::bone_loss_by_signal`]).
+    pub bones_by_signal: bool,
     /// Weight of the extra root-column MSE (None when 0).
     pub root: Option<f32>,
     /// The x0 MSE per clip ([`per_clip_mse`]) rather than per frame.
     pub per_clip: bool,
+    /// `(t₀, cap)` of [`TrainConfig::low_noise_below`] (None when off).
+    pub low_noise: Option<(usize, f32)>,
 }
 
 impl GeometricLosses {
@@ -273,8 +310,11 @@ impl GeometricLosses {
             foot: FootLoss::new(cfg.foot_loss, mean, std, device),
             velocity: VelocityLoss::new(cfg.velocity_loss, std, device),
             bones: BoneLoss::new(cfg.bone_loss, mean, std, device),
+            bones_by_signal: cfg.bone_loss_by_signal,
             root: (cfg.root_loss > 0.0).then_some(cfg.root_loss as f32),
             per_clip: cfg.loss_per_clip,
+            low_noise: (cfg.low_noise_below > 0)
+                .then_some((cfg.low_noise_below, cfg.low_noise_loss_cap as f32)),
         }
     }
 }
@@ -291,10 +331,23 @@ pub(super) fn batch_loss(
     let (mut input, x0, valid) = to_device(batch, text, device);
     input.x_t = q_sample(schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
     let pred = model.predict_x0(&input);
+    // A clip weighed by w: its error scaled by √w, (√w·e)² = w·e².
+    let weighted = match geometric.low_noise {
+        Some((t0, cap)) => {
+            let root_w: Vec<f32> = low_noise_weights(&batch.timesteps, t0, cap)
+                .iter()
+                .map(|w| w.sqrt())
+                .collect();
+            let b = root_w.len();
+            let root_w: Tensor<3> = Tensor::from_data(TensorData::new(root_w, [b, 1, 1]), device);
+            x0.clone() + (pred.clone() - x0.clone()) * root_w
+        }
+        None => pred.clone(),
+    };
     let mut loss = if geometric.per_clip {
-        per_clip_mse(pred.clone(), x0.clone(), valid.clone())
+        per_clip_mse(weighted, x0.clone(), valid.clone())
     } else {
-        masked_mse(pred.clone(), x0.clone(), valid.clone())
+        masked_mse(weighted, x0.clone(), valid.clone())
     };
     if let Some(f) = &geometric.foot {
         loss = loss
@@ -307,7 +360,19 @@ pub(super) fn batch_loss(
                 .mul_scalar(v.weight);
     }
     if let Some(l) = &geometric.bones {
-        loss = loss + l.term(pred.clone(), valid.clone()).mul_scalar(l.weight);
+        let term = if geometric.bones_by_signal {
+            let signal: Vec<f32> = batch
+                .timesteps
+                .iter()
+                .map(|&t| schedule.alphas_cumprod[t] as f32)
+                .collect();
+            let b = signal.len();
+            let signal: Tensor<3> = Tensor::from_data(TensorData::new(signal, [b, 1, 1]), device);
+            l.weighted_term(pred.clone(), valid.clone(), signal)
+        } else {
+            l.term(pred.clone(), valid.clone())
+        };
+        loss = loss + term.mul_scalar(l.weight);
     }
     if let Some(w) = geometric.root {
         loss = loss + root_mse(pred, x0, valid).mul_scalar(w);
@@ -318,6 +383,17 @@ pub(super) fn batch_loss(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn low_noise_weights_grow_as_the_noise_shrinks_below_t0_and_are_capped() {
+        let w = low_noise_weights(&[0, 50, 99, 100, 900], 100, 50.0);
+        assert_eq!(w[0], 50.0, "t = 0 is capped");
+        let a = NoiseSchedule::cosine(crate::model::schedule::DIFFUSION_STEPS).alphas_cumprod;
+        let want = ((1.0 - a[100]) / (1.0 - a[50])) as f32;
+        assert!((w[1] - want).abs() < 1e-3 && w[1] > 1.0, "{w:?} vs {want}");
+        assert!(w[2] >= 1.0 && w[2] < w[1]);
+        assert_eq!(&w[3..], &[1.0, 1.0]);
+    }
 
     #[test]
     fn per_clip_mse_weighs_clips_not_frames() {
@@ -373,5 +449,13 @@ mod tests {
         let stretched = term(0.02);
         let want = 4.0 / 21.0 * 2.0 / 3.0;
         assert!((stretched - want).abs() < 0.02, "{stretched} vs {want}");
+        // Weighted by a signal fraction of 0.25, the same stretch counts a quarter.
+        let (x, mean, std) = rest_features(0.02);
+        let loss = BoneLoss::new(1.0, &mean, &std, &device).unwrap();
+        let pred = Tensor::<3>::from_data(TensorData::new(x, [1, 2, FEATURE_DIM]), &device);
+        let quarter = loss
+            .weighted_term(pred, valid, Tensor::full([1, 1, 1], 0.25, &device))
+            .into_scalar::<f32>();
+        assert!((quarter - stretched / 4.0).abs() < 1e-3, "{quarter}");
     }
 }
