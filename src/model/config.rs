@@ -42,6 +42,14 @@ pub struct ModelConfig {
     /// field have 1.
     #[serde(default = "one_tap", skip_serializing_if = "is_one_tap")]
     pub skip_taps: usize,
+    /// Add the prompt's side vector, its sentence vector minus that of the prompt with
+    /// left and right swapped, through its own zero-initialised linear layer into the
+    /// condition token (sentence encoders only). "kicks the left leg forward" and "… the
+    /// right leg …" have cosine 0.986, so the side is a small part of either vector; the
+    /// difference is all side, zero for a prompt that names none, and flips sign exactly
+    /// under mirroring. Bundles without the field have none.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub side_input: bool,
 }
 
 /// The text encoder of a denoiser.
@@ -96,6 +104,7 @@ impl Default for ModelConfig {
             max_frames: 196,
             input_skip: false,
             skip_taps: 1,
+            side_input: false,
         }
     }
 }
@@ -264,6 +273,9 @@ impl ModelConfig {
         in_range("skip_taps", self.skip_taps, 1, MAX_SKIP_TAPS)?;
         if self.skip_taps.is_multiple_of(2) {
             return Err(format!("`skip_taps` ({}) must be odd", self.skip_taps));
+        }
+        if self.side_input && self.text_encoder != TextEncoderKind::Sentence {
+            return Err("`side_input` needs `text_encoder = \"minilm\"`".into());
         }
         if self.skip_taps > 1 && !self.input_skip {
             return Err("`skip_taps` above 1 needs `input_skip = true`".into());

@@ -45,6 +45,8 @@ pub struct Mdm {
     /// The bag-of-words encoder; None when the model reads sentence vectors.
     text: Option<BagOfWords>,
     text_proj: Linear,
+    /// Side vector → condition token ([`ModelConfig::side_input`]), zero at first.
+    side_proj: Option<Linear>,
     encoder: TransformerEncoder,
     output_proj: Linear,
     /// Timestep sinusoid → per-feature gain on x_t added to the output (`input_skip`).
@@ -58,6 +60,15 @@ pub struct Mdm {
 /// A `d → features` linear layer that starts at zero (weights and bias).
 fn zero_skip(d: usize, features: usize, device: &Device) -> Linear {
     LinearConfig::new(d, features)
+        .with_initializer(burn::nn::Initializer::Zeros)
+        .init(device)
+}
+
+/// The side input's layer: zero, and without a bias, so that a prompt naming no side (and
+/// the unconditioned pass) gets exactly nothing from it.
+fn zero_side(d_text: usize, d: usize, device: &Device) -> Linear {
+    LinearConfig::new(d_text, d)
+        .with_bias(false)
         .with_initializer(burn::nn::Initializer::Zeros)
         .init(device)
 }
@@ -89,6 +100,9 @@ impl Mdm {
             text: (config.text_encoder == TextEncoderKind::BagOfWords)
                 .then(|| BagOfWords::new(vocab_size, config.d_text, device)),
             text_proj: LinearConfig::new(config.d_text, d).init(device),
+            side_proj: config
+                .side_input
+                .then(|| zero_side(config.d_text, d, device)),
             encoder: TransformerEncoderConfig::new(d, config.d_ff, config.heads, config.layers)
                 .with_dropout(config.dropout)
                 .init(device),
@@ -138,6 +152,17 @@ impl Mdm {
         self
     }
 
+    /// This denoiser with a zero side input added (no change to what it predicts), so a
+    /// sentence-encoder model trained without [`ModelConfig::side_input`] can continue with
+    /// it. Already there: unchanged.
+    pub fn with_side_input(mut self, device: &Device) -> Self {
+        if self.side_proj.is_none() {
+            let [d_text, d] = self.text_proj.weight.dims();
+            self.side_proj = Some(zero_side(d_text, d, device));
+        }
+        self
+    }
+
     /// This denoiser with a zero input skip added (no change to what it predicts), so a
     /// model trained without `input_skip` can continue training with it.
     pub fn with_input_skip(mut self, device: &Device) -> Self {
@@ -161,13 +186,22 @@ impl Mdm {
     fn condition(&self, input: &DenoiserInput, device: &Device) -> Tensor<2> {
         let t = sinusoids(input.timesteps.iter().copied(), self.d_model, device);
         let t = self.time_2.forward(silu(self.time_1.forward(t)));
-        let text = match (&self.text, &input.text) {
-            (Some(bag), TextBatch::Words(tokens)) => bag.encode(tokens),
-            (None, TextBatch::Sentences(s)) => s.vectors.clone(),
+        let keep = input.keep_text.clone().unsqueeze_dim::<2>(1);
+        let (text, side) = match (&self.text, &input.text) {
+            (Some(bag), TextBatch::Words(tokens)) => (bag.encode(tokens), None),
+            (None, TextBatch::Sentences(s)) => (
+                s.vectors.clone(),
+                self.side_proj
+                    .as_ref()
+                    .map(|p| p.forward((s.vectors.clone() - s.mirrored.clone()) * keep.clone())),
+            ),
             _ => unreachable!("the bundle's prompt encoder matches its denoiser"),
         }; // [B, d_text]
-        let text = text * input.keep_text.clone().unsqueeze_dim::<2>(1);
-        t + self.text_proj.forward(text)
+        let cond = t + self.text_proj.forward(text * keep);
+        match side {
+            Some(side) => cond + side,
+            None => cond,
+        }
     }
 }
 
@@ -362,5 +396,66 @@ mod tests {
         // Sample 1 (4 valid): frame 5 (padding) reads the last valid frame, 3.
         assert_eq!(row(got.clone(), 1, 5), row(x.clone(), 1, 3));
         assert_eq!(row(got, 1, 2), row(x, 1, 0));
+    }
+
+    fn sentence_input(v: Vec<f32>, m: Vec<f32>, keep: f32, dev: &Device) -> DenoiserInput {
+        use crate::model::prompt::SentenceBatch;
+        let vec = |x: Vec<f32>| Tensor::<2>::from_data(TensorData::new(x, [1, 8]), dev);
+        DenoiserInput {
+            x_t: NoiseSource::new(5).tensor([1, 6, 263], dev),
+            timesteps: vec![300],
+            text: TextBatch::Sentences(SentenceBatch {
+                vectors: vec(v),
+                mirrored: vec(m),
+            }),
+            keep_text: Tensor::full([1], keep, dev),
+            padding: None,
+        }
+    }
+
+    #[test]
+    fn the_side_input_reads_only_the_difference_from_the_swapped_prompt() {
+        let dev = Device::flex();
+        let cfg = ModelConfig {
+            text_encoder: TextEncoderKind::Sentence,
+            side_input: true,
+            ..tiny(1)
+        };
+        let plain = Mdm::new(
+            &ModelConfig {
+                side_input: false,
+                ..cfg.clone()
+            },
+            0,
+            &dev,
+        );
+        // Added at zero it changes nothing.
+        let added = plain.clone().with_side_input(&dev);
+        let v: Vec<f32> = (0..8).map(|i| i as f32 / 8.0).collect();
+        let m: Vec<f32> = v.iter().rev().copied().collect();
+        let predict = |model: &Mdm, v: &[f32], m: &[f32], keep: f32| {
+            model
+                .clone()
+                .valid()
+                .predict_x0(&sentence_input(v.to_vec(), m.to_vec(), keep, &dev))
+        };
+        let max_diff = |a: Tensor<3>, b: Tensor<3>| (a - b).abs().max().into_scalar::<f32>();
+        assert_eq!(
+            max_diff(predict(&plain, &v, &m, 1.0), predict(&added, &v, &m, 1.0)),
+            0.0
+        );
+        // Trained (random here), it acts on a prompt that names a side ...
+        let mut side = added;
+        side.side_proj = Some(LinearConfig::new(8, 16).with_bias(false).init(&dev));
+        assert!(max_diff(predict(&plain, &v, &m, 1.0), predict(&side, &v, &m, 1.0)) > 1e-4);
+        // ... not on one that names none (swapping changes nothing), nor unconditioned.
+        assert!(max_diff(predict(&plain, &v, &v, 1.0), predict(&side, &v, &v, 1.0)) < 1e-6);
+        assert!(max_diff(predict(&plain, &v, &m, 0.0), predict(&side, &v, &m, 0.0)) < 1e-6);
+        // A bag-of-words model cannot have one.
+        let bad = ModelConfig {
+            text_encoder: TextEncoderKind::BagOfWords,
+            ..cfg
+        };
+        assert!(bad.check().unwrap_err().contains("side_input"));
     }
 }

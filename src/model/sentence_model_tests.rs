@@ -198,3 +198,67 @@ fn the_length_prior_gives_the_nearest_training_captions_length() {
     let old = ModelBundle::load(&bundle_dir, &dev).unwrap();
     assert!(old.text.natural_frames("a person walks", 196).is_none());
 }
+
+#[test]
+fn a_training_batch_pairs_each_caption_with_its_side_swapped_one() {
+    use super::lengths::CaptionLengths;
+    use super::prompt::TextBatch;
+    use super::sentence::CaptionIndex;
+    use super::train::TrainText;
+    let dev = Device::flex();
+    let encoder = std::sync::Arc::new(SentenceEncoder::load(&default_encoder_dir(), &dev).unwrap());
+    let captions = [
+        "a person kicks the left leg forward",
+        "a person kicks the right leg forward",
+        "a person walks forward",
+    ];
+    let index = CaptionIndex::build(&encoder, &captions);
+    let text = TrainText::sentences(
+        encoder.clone(),
+        index,
+        CaptionLengths::of_dataset(&synthetic_dataset()),
+    );
+    // Known captions, and one the index lacks (word dropout's), whose swap it lacks too.
+    let batch = text.batch(
+        &[captions[0], captions[2], "a person raises the left hand"],
+        &dev,
+    );
+    let TextBatch::Sentences(s) = batch else {
+        panic!("a sentence batch")
+    };
+    let row = |t: &Tensor<2>, i: usize| t.clone().narrow(0, i, 1);
+    let want = encoder.encode(&[captions[1], captions[2], "a person raises the right hand"]);
+    let diff = (s.mirrored.clone() - want).abs().max().into_scalar::<f32>();
+    assert!(diff < 1e-5, "{diff}");
+    // A caption naming no side is its own swap: its side vector is exactly zero.
+    let side = (row(&s.vectors, 1) - row(&s.mirrored, 1))
+        .abs()
+        .max()
+        .into_scalar::<f32>();
+    assert_eq!(side, 0.0);
+}
+
+#[test]
+fn a_sentence_bundle_starts_a_run_with_the_side_input() {
+    let dev = Device::flex();
+    let base = tempfile::tempdir().unwrap();
+    train(base.path(), sentence_tiny(), None, 1e-3, 5);
+    let run = tempfile::tempdir().unwrap();
+    let with_side = ModelConfig {
+        side_input: true,
+        ..sentence_tiny()
+    };
+    train(
+        run.path(),
+        with_side,
+        Some(&base.path().join("bundle")),
+        1e-3,
+        5,
+    );
+    let bundle = ModelBundle::load(&run.path().join("bundle"), &dev).unwrap();
+    assert!(bundle.config.side_input);
+    assert_eq!(bundle.manifest.steps, 10);
+    let names = tensors(&bundle.model);
+    assert_eq!(names["side_proj.weight"].len(), 384 * tiny().d_model);
+    assert!(!names.contains_key("side_proj.bias"));
+}

@@ -61,9 +61,13 @@ impl TrainRun<'_> {
                 // centre tap); a wider one cannot narrow.
                 let widen_skip = (bundle.config.skip_taps == 1 && cfg.model.skip_taps > 1)
                     .then_some(cfg.model.skip_taps);
+                // A sentence model without the side input may start a run with it (added
+                // at zero).
+                let add_side = cfg.model.side_input && !bundle.config.side_input;
                 let as_run = ModelConfig {
                     input_skip: bundle.config.input_skip || cfg.model.input_skip,
                     skip_taps: widen_skip.unwrap_or(bundle.config.skip_taps),
+                    side_input: bundle.config.side_input || cfg.model.side_input,
                     ..bundle.config.clone()
                 };
                 let weights = init.join("model.safetensors");
@@ -107,6 +111,10 @@ impl TrainRun<'_> {
                 if add_skip {
                     model = model.with_input_skip(train_dev);
                     ema = ema.with_input_skip(plain);
+                }
+                if add_side {
+                    model = model.with_side_input(train_dev);
+                    ema = ema.with_side_input(plain);
                 }
                 if let Some(taps) = widen_skip {
                     model = model.with_skip_taps(taps);

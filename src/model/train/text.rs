@@ -7,7 +7,9 @@ use crate::dataset::{Dataset, Split};
 use crate::fsutil::write_bytes_atomic;
 use crate::model::config::TextEncoderKind;
 use crate::model::lengths::CaptionLengths;
-use crate::model::prompt::{PromptEncoder, SentenceBatch, SentencePrompts, TextBatch};
+use crate::model::prompt::{
+    PromptEncoder, SentenceBatch, SentencePrompts, TextBatch, swap_side_words,
+};
 use crate::model::sentence::{CaptionIndex, SentenceEncoder, default_encoder_dir};
 use crate::model::text::{TokenBatch, Vocabulary};
 use crate::model::weights::TrainedAction;
@@ -70,9 +72,17 @@ impl TrainText {
         match self {
             TrainText::Words(v) => TextBatch::Words(TokenBatch::new(v, captions, device)),
             TrainText::Sentences { prompts, rows } => {
+                // Each caption, then each caption with its sides swapped (the side input's
+                // other half; the data's mirrored copies hold most of them).
+                let swapped: Vec<String> = captions.iter().map(|c| swap_side_words(c)).collect();
+                let all: Vec<&str> = captions
+                    .iter()
+                    .copied()
+                    .chain(swapped.iter().map(String::as_str))
+                    .collect();
                 let known = prompts.captions.embeddings();
                 let mut extra: Vec<&str> = Vec::new();
-                let ids: Vec<i64> = captions
+                let ids: Vec<i64> = all
                     .iter()
                     .map(|c| match rows.get(*c) {
                         Some(&r) => r as i64,
@@ -93,11 +103,11 @@ impl TrainText {
                 };
                 let n = ids.len();
                 let ids = Tensor::<1, Int>::from_data(TensorData::new(ids, [n]), &known.device());
-                let vectors = table.select(0, ids).to_device(device);
-                // Training never mirror-averages: the data holds the mirrored copies.
+                let both = table.select(0, ids).to_device(device);
+                let b = captions.len();
                 TextBatch::Sentences(SentenceBatch {
-                    mirrored: vectors.clone(),
-                    vectors,
+                    vectors: both.clone().narrow(0, 0, b),
+                    mirrored: both.narrow(0, b, b),
                 })
             }
         }
