@@ -8,14 +8,15 @@
 //! cargo run --release --example caption_probe -- <bundle> <dataset> <clip name> [other caption]
 //! ```
 
+mod probe_clip;
+
 use burn::prelude::*;
-use mprog::dataset::{Dataset, FEATURE_DIM};
-use mprog::features::{denormalize_slice, normalize_slice, recover_from_ric};
-use mprog::model::ModelBundle;
+use mprog::dataset::FEATURE_DIM;
+use mprog::features::{denormalize_slice, recover_from_ric};
 use mprog::model::denoiser::{Denoiser, DenoiserInput};
 use mprog::model::noise::NoiseSource;
 use mprog::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
-use std::path::PathBuf;
+use probe_clip::ProbeClip;
 
 /// Highest ankle (m) and highest lowest-foot-joint (both feet up, m) of a feature clip,
 /// both above the clip's lowest foot joint.
@@ -44,26 +45,19 @@ fn heights(raw: &[f32]) -> (f32, f32) {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() < 4 {
-        eprintln!("usage: caption_probe <bundle> <dataset> <clip name> [other caption]");
-        std::process::exit(2);
-    }
-    let device = Device::flex();
-    let bundle = ModelBundle::load(&PathBuf::from(&args[1]), &device).expect("bundle");
-    let data = Dataset::load(&PathBuf::from(&args[2])).expect("dataset");
-    let clip = data
-        .index
-        .clips
-        .iter()
-        .find(|c| c.name == args[3])
-        .expect("no clip of that name");
+    let ProbeClip {
+        device,
+        bundle,
+        clip,
+        frames: n,
+        raw,
+        clean,
+    } = probe_clip::load(
+        &args,
+        "caption_probe <bundle> <dataset> <clip name> [other caption]",
+    );
     let other = args.get(4).map_or("a person walks forward", String::as_str);
-    let n = clip.frames.min(bundle.config.max_frames);
-    let raw = &data.clip_features(clip)[..n * FEATURE_DIM];
-    let mut x0 = raw.to_vec();
-    normalize_slice(&mut x0, &bundle.mean, &bundle.std).expect("feature rows");
-    let clean: Tensor<3> = Tensor::from_data(TensorData::new(x0, [1, n, FEATURE_DIM]), &device);
-    let (ankle, both) = heights(raw);
+    let (ankle, both) = heights(&raw);
     println!(
         "{} ({} steps); clip {} ({n} frames, \"{}\"): ankle {ankle:.2} m, both feet {both:.2} m",
         bundle.manifest.weights_id, bundle.manifest.steps, clip.name, clip.captions[0]

@@ -9,15 +9,16 @@
 //! cargo run --release --example low_noise_probe -- <bundle> <dataset> <clip name>
 //! ```
 
+mod probe_clip;
+
 use burn::prelude::*;
-use mprog::dataset::{Dataset, FEATURE_DIM};
-use mprog::features::{denormalize_slice, normalize_slice, recover_from_ric};
-use mprog::model::ModelBundle;
+use mprog::dataset::FEATURE_DIM;
+use mprog::features::{denormalize_slice, recover_from_ric};
 use mprog::model::denoiser::{Denoiser, DenoiserInput};
 use mprog::model::noise::NoiseSource;
 use mprog::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use mprog::skeleton::{NUM_JOINTS, PARENTS};
-use std::path::PathBuf;
+use probe_clip::ProbeClip;
 
 /// (bone variation, jitter in cm) of a raw feature clip.
 fn roughness(raw: &[f32]) -> (f32, f32) {
@@ -47,25 +48,15 @@ fn roughness(raw: &[f32]) -> (f32, f32) {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() < 4 {
-        eprintln!("usage: low_noise_probe <bundle> <dataset> <clip name>");
-        std::process::exit(2);
-    }
-    let device = Device::flex();
-    let bundle = ModelBundle::load(&PathBuf::from(&args[1]), &device).expect("bundle");
-    let data = Dataset::load(&PathBuf::from(&args[2])).expect("dataset");
-    let clip = data
-        .index
-        .clips
-        .iter()
-        .find(|c| c.name == args[3])
-        .expect("no clip of that name");
-    let n = clip.frames.min(bundle.config.max_frames);
-    let raw = &data.clip_features(clip)[..n * FEATURE_DIM];
-    let mut x0 = raw.to_vec();
-    normalize_slice(&mut x0, &bundle.mean, &bundle.std).expect("feature rows");
-    let clean: Tensor<3> = Tensor::from_data(TensorData::new(x0, [1, n, FEATURE_DIM]), &device);
-    let (v, j) = roughness(raw);
+    let ProbeClip {
+        device,
+        bundle,
+        clip,
+        frames: n,
+        raw,
+        clean,
+    } = probe_clip::load(&args, "low_noise_probe <bundle> <dataset> <clip name>");
+    let (v, j) = roughness(&raw);
     println!(
         "{} ({} steps); clip {} ({n} frames): bones {v:.4}, jitter {j:.3} cm",
         bundle.manifest.weights_id, bundle.manifest.steps, clip.name

@@ -265,13 +265,16 @@ impl BoneLoss {
 }
 
 /// Each sample's x0-MSE weight under [`TrainConfig::low_noise_below`]: `(1−ᾱ_t0)/(1−ᾱ_t)`
-/// below `t0`, at most `cap`, and 1 from `t0` on (the noise variance of `t0` over `t`'s).
-pub fn low_noise_weights(timesteps: &[usize], t0: usize, cap: f32) -> Vec<f32> {
-    use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
-    use std::sync::OnceLock;
-    static ALPHAS: OnceLock<Vec<f64>> = OnceLock::new();
-    let alphas = ALPHAS.get_or_init(|| NoiseSchedule::cosine(DIFFUSION_STEPS).alphas_cumprod);
-    let noise = |t: usize| 1.0 - alphas[t.min(DIFFUSION_STEPS - 1)];
+/// below `t0`, at most `cap`, and 1 from `t0` on (the noise variance of `t0` over `t`'s),
+/// with `alphas_cumprod` the base schedule's ᾱ.
+pub fn low_noise_weights(
+    alphas_cumprod: &[f64],
+    timesteps: &[usize],
+    t0: usize,
+    cap: f32,
+) -> Vec<f32> {
+    let last = alphas_cumprod.len() - 1;
+    let noise = |t: usize| 1.0 - alphas_cumprod[t.min(last)];
     timesteps
         .iter()
         .map(|&t| {
@@ -334,10 +337,11 @@ pub(super) fn batch_loss(
     // A clip weighed by w: its error scaled by √w, (√w·e)² = w·e².
     let weighted = match geometric.low_noise {
         Some((t0, cap)) => {
-            let root_w: Vec<f32> = low_noise_weights(&batch.timesteps, t0, cap)
-                .iter()
-                .map(|w| w.sqrt())
-                .collect();
+            let root_w: Vec<f32> =
+                low_noise_weights(&schedule.alphas_cumprod, &batch.timesteps, t0, cap)
+                    .iter()
+                    .map(|w| w.sqrt())
+                    .collect();
             let b = root_w.len();
             let root_w: Tensor<3> = Tensor::from_data(TensorData::new(root_w, [b, 1, 1]), device);
             x0.clone() + (pred.clone() - x0.clone()) * root_w
@@ -386,9 +390,9 @@ mod tests {
 
     #[test]
     fn low_noise_weights_grow_as_the_noise_shrinks_below_t0_and_are_capped() {
-        let w = low_noise_weights(&[0, 50, 99, 100, 900], 100, 50.0);
-        assert_eq!(w[0], 50.0, "t = 0 is capped");
         let a = NoiseSchedule::cosine(crate::model::schedule::DIFFUSION_STEPS).alphas_cumprod;
+        let w = low_noise_weights(&a, &[0, 50, 99, 100, 900], 100, 50.0);
+        assert_eq!(w[0], 50.0, "t = 0 is capped");
         let want = ((1.0 - a[100]) / (1.0 - a[50])) as f32;
         assert!((w[1] - want).abs() < 1e-3 && w[1] > 1.0, "{w:?} vs {want}");
         assert!(w[2] >= 1.0 && w[2] < w[1]);
