@@ -175,6 +175,7 @@ fn tiny_config() -> ModelConfig {
         max_frames: 40,
         input_skip: false,
         skip_taps: 1,
+        skip_taps_below: None,
         side_input: false,
     }
 }

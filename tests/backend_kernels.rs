@@ -265,6 +265,45 @@ fn select_gradient_scatters_back_to_every_index() {
 }
 
 #[test]
+fn slice_gradients_add_into_their_parent_in_place() {
+    // The patched burn-autodiff adds a slice's gradient into the parent's gradient
+    // accumulated so far: overlapping slices, disjoint columns and a whole-tensor use of
+    // the same parent must sum exactly as separate zero-filled gradients would.
+    let device = Device::flex().autodiff();
+    for (rows, seed) in [(10, 80), (20_000, 81)] {
+        let c = 3;
+        let x = random(rows * c, -1.0, 1.0, seed);
+        let input: Tensor<2> =
+            Tensor::from_data(TensorData::new(x.clone(), [rows, c]), &device).require_grad();
+        let col = |k: usize| input.clone().narrow(1, k, 1);
+        let head = input.clone().narrow(0, 0, rows / 2); // overlaps the columns
+        let loss = col(0).mul_scalar(2.0).sum()
+            + col(2).powf_scalar(2.0).sum()
+            + col(0).mul_scalar(3.0).sum()
+            + head.mul_scalar(5.0).sum()
+            + input.clone().mul_scalar(0.5).sum();
+        let grad = input
+            .grad(&loss.backward())
+            .unwrap()
+            .into_data()
+            .try_into_vec::<f32>()
+            .unwrap();
+        for r in 0..rows {
+            for k in 0..c {
+                let mut want = 0.5 + if r < rows / 2 { 5.0 } else { 0.0 };
+                match k {
+                    0 => want += 5.0,
+                    2 => want += 2.0 * x[r * c + k],
+                    _ => {}
+                }
+                let g = grad[r * c + k];
+                assert!((g - want).abs() < 1e-5, "grad[{r}, {k}] = {g}, want {want}");
+            }
+        }
+    }
+}
+
+#[test]
 fn a_seeded_dropout_mask_repeats() {
     use burn::tensor::Distribution;
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());

@@ -45,6 +45,7 @@ fn model_config(d_model: usize, layers: usize) -> ModelConfig {
         max_frames: 40,
         input_skip: false,
         skip_taps: 1,
+        skip_taps_below: None,
         side_input: false,
     }
 }

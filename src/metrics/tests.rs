@@ -256,6 +256,7 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
         max_frames: 50,
         input_skip: false,
         skip_taps: 1,
+        skip_taps_below: None,
         side_input: false,
         ..ModelConfig::default()
     };

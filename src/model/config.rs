@@ -42,6 +42,12 @@ pub struct ModelConfig {
     /// field have 1.
     #[serde(default = "one_tap", skip_serializing_if = "is_one_tap")]
     pub skip_taps: usize,
+    /// Timestep from which only the centre skip tap reads (None: all taps at every t).
+    /// At high t the outer taps pass smoothed noise into x̂0, a slow wobble of the bone
+    /// lengths that the attention layers must then cancel; below this the neighbours are
+    /// nearly clean and the filter is what beats the transformer.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub skip_taps_below: Option<usize>,
     /// Add the prompt's side vector, its sentence vector minus that of the prompt with
     /// left and right swapped, through its own zero-initialised linear layer into the
     /// condition token (sentence encoders only). "kicks the left leg forward" and "… the
@@ -104,6 +110,7 @@ impl Default for ModelConfig {
             max_frames: 196,
             input_skip: false,
             skip_taps: 1,
+            skip_taps_below: None,
             side_input: false,
         }
     }
@@ -279,6 +286,12 @@ impl ModelConfig {
         }
         if self.skip_taps > 1 && !self.input_skip {
             return Err("`skip_taps` above 1 needs `input_skip = true`".into());
+        }
+        if let Some(below) = self.skip_taps_below {
+            in_range("skip_taps_below", below, 1, MAX_SIZE)?;
+            if self.skip_taps == 1 {
+                return Err("`skip_taps_below` needs `skip_taps` above 1".into());
+            }
         }
         fraction("dropout", self.dropout, true)
     }

@@ -55,6 +55,9 @@ pub struct Mdm {
     d_model: usize,
     /// Frames the input skip reads around each frame ([`ModelConfig::skip_taps`]).
     skip_taps: usize,
+    /// Timestep from which only the centre tap reads ([`ModelConfig::skip_taps_below`];
+    /// `usize::MAX`: every tap at every t).
+    skip_taps_below: usize,
 }
 
 /// A `d → features` linear layer that starts at zero (weights and bias).
@@ -113,6 +116,7 @@ impl Mdm {
             dropout: DropoutConfig::new(config.dropout).init(),
             d_model: d,
             skip_taps: config.skip_taps,
+            skip_taps_below: config.skip_taps_below.unwrap_or(usize::MAX),
         }
     }
 
@@ -179,7 +183,27 @@ impl Mdm {
         let skip = self.skip.as_ref()?;
         let device = skip.weight.device();
         let gain = skip.forward(sinusoids(std::iter::once(t), self.d_model, &device));
-        Some(gain.into_data().try_into_vec::<f32>().expect("f32 tensor"))
+        let mut gain = gain.into_data().try_into_vec::<f32>().expect("f32 tensor");
+        let f = gain.len() / self.skip_taps;
+        for (tap, g) in gain.chunks_mut(f).enumerate() {
+            if !self.tap_reads(tap, t) {
+                g.fill(0.0);
+            }
+        }
+        Some(gain)
+    }
+
+    /// Whether skip tap `tap` reads its frame at timestep `t`: the centre tap always, the
+    /// others below [`ModelConfig::skip_taps_below`].
+    fn tap_reads(&self, tap: usize, t: usize) -> bool {
+        tap == self.skip_taps / 2 || t < self.skip_taps_below
+    }
+
+    /// This denoiser with its outer skip taps read only below timestep `below` (None: at
+    /// every t), as [`ModelConfig::skip_taps_below`] says.
+    pub fn with_skip_taps_below(mut self, below: Option<usize>) -> Self {
+        self.skip_taps_below = below.unwrap_or(usize::MAX);
+        self
     }
 
     /// `[B, d]` condition token: timestep embedding plus (possibly dropped) text.
@@ -286,6 +310,20 @@ impl Mdm {
             .reshape([b, k, f])
             .swap_dims(0, 1)
             .unsqueeze_dim::<4>(2);
+        let gains = if self.skip_taps_below == usize::MAX {
+            gains
+        } else {
+            // [K, B, 1, 1]: 0 where a tap is shut at its sample's t.
+            let open: Vec<f32> = (0..k)
+                .flat_map(|tap| {
+                    input
+                        .timesteps
+                        .iter()
+                        .map(move |&t| f32::from(u8::from(self.tap_reads(tap, t))))
+                })
+                .collect();
+            gains * Tensor::<4>::from_data(TensorData::new(open, [k, b, 1, 1]), &device)
+        };
         (taps * gains).sum_dim(0).reshape([b, n, f])
     }
 }
@@ -396,6 +434,50 @@ mod tests {
         // Sample 1 (4 valid): frame 5 (padding) reads the last valid frame, 3.
         assert_eq!(row(got.clone(), 1, 5), row(x.clone(), 1, 3));
         assert_eq!(row(got, 1, 2), row(x, 1, 0));
+    }
+
+    #[test]
+    fn outer_taps_read_only_below_their_timestep() {
+        let dev = Device::flex();
+        let model = Mdm::new(
+            &ModelConfig {
+                skip_taps_below: Some(30),
+                ..tiny(5)
+            },
+            8,
+            &dev,
+        );
+        // Tap 0 (two frames back) and the centre tap pass their frames, gain 1 each.
+        let mut bias = vec![0.0f32; 5 * 263];
+        bias[..263].fill(1.0);
+        bias[2 * 263..3 * 263].fill(1.0);
+        let mut skip = zero_skip(16, 5 * 263, &dev);
+        skip.bias = Some(burn::module::Param::from_tensor(Tensor::from_data(
+            TensorData::new(bias, [5 * 263]),
+            &dev,
+        )));
+        let mut inp = input(6, &[6, 6], &dev);
+        inp.timesteps = vec![29, 30]; // sample 0 below, sample 1 at the threshold
+        let got = model.filtered_skip(&skip, &inp);
+        let x = inp.x_t.clone();
+        let frame = |t: Tensor<3>, s: usize, f: usize| t.narrow(0, s, 1).narrow(1, f, 1);
+        let diff = |a: Tensor<3>, b: Tensor<3>| (a - b).abs().max().into_scalar::<f32>();
+        // Below: frame 3 is itself plus frame 1; at 30: itself alone.
+        let both = frame(x.clone(), 0, 3) + frame(x.clone(), 0, 1);
+        assert!(diff(frame(got.clone(), 0, 3), both) < 1e-6);
+        assert!(diff(frame(got, 1, 3), frame(x, 1, 3)) < 1e-6);
+        // The reported gains agree.
+        let mut m = model;
+        m.skip = Some(skip);
+        let g = m.input_skip_gain(30).unwrap();
+        assert!(g[..263].iter().all(|&v| v == 0.0) && g[2 * 263] == 1.0);
+        assert_eq!(m.input_skip_gain(29).unwrap()[0], 1.0);
+        // Only with several taps.
+        let one = ModelConfig {
+            skip_taps_below: Some(30),
+            ..tiny(1)
+        };
+        assert!(one.check().unwrap_err().contains("skip_taps_below"));
     }
 
     fn sentence_input(v: Vec<f32>, m: Vec<f32>, keep: f32, dev: &Device) -> DenoiserInput {

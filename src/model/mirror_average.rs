@@ -180,6 +180,7 @@ mod tests {
             max_frames: 40,
             input_skip: false,
             skip_taps: 1,
+            skip_taps_below: None,
             side_input: false,
         };
         let net = Mdm::new(&cfg, vocab().len(), &dev).valid();

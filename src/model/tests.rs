@@ -26,6 +26,7 @@ pub(super) fn tiny() -> ModelConfig {
         max_frames: 40,
         input_skip: false,
         skip_taps: 1,
+        skip_taps_below: None,
         side_input: false,
     }
 }

@@ -66,6 +66,7 @@ pub(super) fn tiny_bundle() -> ModelBundle {
         max_frames: 40,
         input_skip: false,
         skip_taps: 1,
+        skip_taps_below: None,
         side_input: false,
     };
     let vocab = Vocabulary::from_captions(["a person walks forward", "a person waves"], 8);

@@ -68,6 +68,8 @@ impl TrainRun<'_> {
                     input_skip: bundle.config.input_skip || cfg.model.input_skip,
                     skip_taps: widen_skip.unwrap_or(bundle.config.skip_taps),
                     side_input: bundle.config.side_input || cfg.model.side_input,
+                    // When the outer taps read is the run's choice; it has no weights.
+                    skip_taps_below: cfg.model.skip_taps_below,
                     ..bundle.config.clone()
                 };
                 let weights = init.join("model.safetensors");
@@ -120,6 +122,11 @@ impl TrainRun<'_> {
                     model = model.with_skip_taps(taps);
                     ema = ema.with_skip_taps(taps);
                 }
+                let below = cfg.model.skip_taps_below;
+                let (model, ema) = (
+                    model.with_skip_taps_below(below),
+                    ema.with_skip_taps_below(below),
+                );
                 return Ok(Checkpoint {
                     model,
                     ema,
