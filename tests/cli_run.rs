@@ -184,29 +184,36 @@ fn spacing_sets_where_the_people_start() {
 
 #[test]
 fn gen_says_how_it_read_the_prompt() {
+    // The shipped model reads sentences: a prompt far from every training caption is
+    // conditioned on its nearest captions, and `gen` names them.
     let dir = tempfile::tempdir().unwrap();
     let npy = dir.path().join("out.npy");
-    let out = run(&[
-        "gen",
-        "--text",
-        "a man walked forwards, moonwalking",
-        "--frames",
-        "10",
-        "--steps",
-        "2",
-        "-o",
-        npy.to_str().unwrap(),
-    ]);
-    let (_, stderr) = text(&out);
-    assert!(out.status.success(), "{stderr}");
+    let generate = |extra: &[&str]| {
+        let mut args = vec![
+            "gen",
+            "--text",
+            "a man walked forwards, moonwalking",
+            "--frames",
+            "10",
+            "--steps",
+            "2",
+            "-o",
+            npy.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = run(&args);
+        let (_, stderr) = text(&out);
+        assert!(out.status.success(), "{stderr}");
+        stderr
+    };
+    let stderr = generate(&[]);
     assert!(
-        stderr.contains("read as words the model knows: walked → walks, forwards → forward"),
+        stderr.contains("the model has not read a caption like this")
+            && stderr.contains("nearest captions, \"")
+            && stderr.contains("--literal-prompt reads it as written"),
         "{stderr}"
     );
-    assert!(
-        stderr.contains("ignored words the model does not know: moonwalking"),
-        "{stderr}"
-    );
+    assert!(!generate(&["--literal-prompt"]).contains("nearest captions"));
 }
 
 #[test]
@@ -261,6 +268,8 @@ fn a_bundle_with_a_controlnet_adds_guide_without_realism_to_the_task_table() {
         "guide.k_late=10",
         "--family",
         "pmg",
+        "--tasks",
+        "hsi-3",
         "--data",
         "/nonexistent",
         "-o",
@@ -271,4 +280,26 @@ fn a_bundle_with_a_controlnet_adds_guide_without_realism_to_the_task_table() {
     let table = std::fs::read_to_string(&md).unwrap();
     assert!(table.contains("| guide |"), "{table}");
     assert!(table.contains("| guide, realism 0 |"), "{table}");
+    assert!(
+        table.contains("HSI-3") && !table.contains("HSC-1"),
+        "--tasks keeps HSI-3 alone: {table}"
+    );
+    // A task name the run does not have is refused, with the names it has.
+    let out = run(&[
+        "bench",
+        "tasks",
+        "--quick",
+        "--model",
+        model.to_str().unwrap(),
+        "--tasks",
+        "HSI-9",
+        "--data",
+        "/nonexistent",
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("no task named `HSI-9`") && stderr.contains("HSC-1"),
+        "{stderr}"
+    );
 }

@@ -46,6 +46,10 @@ pub struct TaskBenchArgs {
     /// Only these task families (comma separated: pmg, head-height, keyframe, contact).
     #[arg(long, value_delimiter = ',', value_enum)]
     family: Vec<Family>,
+    /// Only the tasks with these names, comma separated, as the table's first column
+    /// writes them (`--tasks HSI-2,HSI-4`; case does not matter).
+    #[arg(long, value_delimiter = ',')]
+    tasks: Vec<String>,
     /// Only these solvers, comma separated (default: every registered one; `mprog run --help`
     /// lists them).
     #[arg(long, value_delimiter = ',')]
@@ -244,6 +248,20 @@ pub fn run(args: TaskBenchArgs) -> Result<()> {
     }
     if !args.family.is_empty() {
         tasks.retain(|t| args.family.contains(&t.family));
+    }
+    if !args.tasks.is_empty() {
+        let names: Vec<String> = tasks.iter().map(|t| t.name.clone()).collect();
+        if let Some(unknown) = args
+            .tasks
+            .iter()
+            .find(|w| !names.iter().any(|n| n.eq_ignore_ascii_case(w)))
+        {
+            return Err(miette!(
+                help = format!("the tasks of this run: {}", names.join(", ")),
+                "no task named `{unknown}` in this run"
+            ));
+        }
+        tasks.retain(|t| args.tasks.iter().any(|w| t.name.eq_ignore_ascii_case(w)));
     }
     if tasks.is_empty() {
         return Err(miette!(

@@ -162,29 +162,67 @@ pub fn system_prompt_for(actions: &[(String, usize)]) -> String {
 }
 
 /// "What the motion model knows", generated from the training captions so it cannot drift
-/// from the weights; empty without an action list.
+/// from the weights; empty without an action list. Captions that differ only by a style
+/// word ("a tired person runs forward") are listed once, as "a person …", with their clips
+/// summed; the style words are named once above the list.
 fn actions_section(actions: &[(String, usize)]) -> String {
-    let listed: Vec<&(String, usize)> = actions
+    let (merged, styles) = merge_styles(actions);
+    let listed: Vec<&(String, usize)> = merged
         .iter()
         .filter(|(_, n)| *n >= LISTED_ACTION_CLIPS)
         .collect();
     if listed.is_empty() {
         return String::new();
     }
-    let mut s = String::from(
+    let styles = if styles.is_empty() {
+        String::new()
+    } else {
+        let quoted: Vec<String> = styles.iter().map(|w| format!("\"{w}\"")).collect();
+        format!(
+            " Style words combine with the actions that were captured in styles: {} (\"a tired person walks forward\").",
+            quoted.join(", ")
+        )
+    };
+    let mut s = format!(
         "\n## What the motion model knows\n\n\
          The `prompt` is read by a sentence encoder, so any wording is understood, but the\n\
          model only moves as its training clips did. These are the actions it was trained on\n\
-         (training clips in brackets; style words such as \"tired\", \"happy\" or \"old\" combine\n\
-         with the walks, runs, waves and hand raises). Prompt one of them, or a plain\n\
-         paraphrase; for anything else let the constraints carry the motion. `mprog check`\n\
-         warns when a prompt is far from all of them, and a prompt unlike every one of them\n\
-         is read as the mean of its nearest ones (`mprog run` says which).\n\n",
+         (training clips in brackets).{styles} Prompt one of them, or a plain paraphrase; for\n\
+         anything else let the constraints carry the motion. `mprog check` warns when a\n\
+         prompt is far from all of them, and a prompt unlike every one of them is read as the\n\
+         mean of its nearest ones (`mprog run` says which).\n\n",
     );
     for (caption, n) in listed {
         s.push_str(&format!("- {caption} ({n})\n"));
     }
     s
+}
+
+/// `a <style> person <action>` folded into `a person <action>` (clips summed), most clips
+/// first, and the style words met, in order of first appearance.
+fn merge_styles(actions: &[(String, usize)]) -> (Vec<(String, usize)>, Vec<String>) {
+    let mut merged: Vec<(String, usize)> = Vec::new();
+    let mut styles: Vec<String> = Vec::new();
+    for (caption, n) in actions {
+        let words: Vec<&str> = caption.split(' ').collect();
+        let folded = match words.as_slice() {
+            ["a" | "an", style, "person", rest @ ..]
+                if !rest.is_empty() && style.chars().all(|c| c.is_ascii_lowercase()) =>
+            {
+                if !styles.iter().any(|s| s == style) {
+                    styles.push(style.to_string());
+                }
+                format!("a person {}", rest.join(" "))
+            }
+            _ => caption.clone(),
+        };
+        match merged.iter_mut().find(|(c, _)| *c == folded) {
+            Some((_, total)) => *total += n,
+            None => merged.push((folded, *n)),
+        }
+    }
+    merged.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+    (merged, styles)
 }
 
 const INTRO: &str = r#"# Writing `.mprog` motion programs
@@ -398,5 +436,41 @@ mod tests {
         }
         assert!(card.contains("contact(p, q, d) — **constraint.**"));
         assert!(card.contains("| 15 | `head` |  | 1.48 |"));
+    }
+}
+
+#[cfg(test)]
+mod action_list_tests {
+    use super::*;
+
+    #[test]
+    fn style_variants_are_listed_once_with_their_clips_summed() {
+        let actions: Vec<(String, usize)> = [
+            ("a energetic person raises both hands", 5),
+            ("a person raises both hands", 4),
+            ("a tired person raises both hands", 2),
+            ("a person kicks forward with the left leg", 14),
+            ("a person jumps", 2),
+        ]
+        .iter()
+        .map(|(c, n)| (c.to_string(), *n))
+        .collect();
+        let (merged, styles) = merge_styles(&actions);
+        assert_eq!(
+            merged,
+            vec![
+                ("a person kicks forward with the left leg".to_string(), 14),
+                ("a person raises both hands".to_string(), 11),
+                ("a person jumps".to_string(), 2),
+            ]
+        );
+        assert_eq!(styles, ["energetic", "tired"]);
+        let section = actions_section(&actions);
+        assert!(section.contains("- a person raises both hands (11)"));
+        assert!(section.contains("\"energetic\", \"tired\""));
+        assert!(
+            !section.contains("a person jumps"),
+            "below the listing threshold"
+        );
     }
 }
