@@ -99,6 +99,18 @@ impl ControlNet {
         }
     }
 
+    /// This ControlNet with random (non-zero) hint input and outputs, so that it steers:
+    /// for tests of the solvers that must see it act.
+    #[cfg(test)]
+    pub(crate) fn randomised(mut self, device: &Device) -> ControlNet {
+        let d = self.encoder.d_model;
+        self.hint_in = LinearConfig::new(HINT_DIM, d).init(device);
+        for out in &mut self.zero_out {
+            *out = LinearConfig::new(d, d).init(device);
+        }
+        self
+    }
+
     /// What to add into the denoiser's stream after each of its layers, `[B, N+1, d]`
     /// each, for the denoiser's embedded sequence `seq` and a hint.
     fn controls(

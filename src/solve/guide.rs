@@ -97,6 +97,11 @@ pub struct GuideConfig {
     /// Steer every denoising step through the prior's ControlNet with a hint derived from
     /// the program ([`super::realism`]); acts only when the bundle has a ControlNet.
     pub realism: bool,
+    /// Share of the chain's steps, from the first (noisiest) on, that the ControlNet
+    /// steers (0–1; 1: every step, as OmniControl). The ControlNet is a second encoder
+    /// pass per step: steering the early steps, where pose and path are decided, costs
+    /// that much less.
+    pub realism_share: f32,
 }
 
 /// mprog's additions to OmniControl's inner loop. They exist only on the fused host path,
@@ -177,12 +182,13 @@ impl Default for GuideConfig {
             smooth_frames: 4.0,
             fused: Some(FusedSettings::default()),
             realism: true,
+            realism_share: 1.0,
         }
     }
 }
 
 impl GuideConfig {
-    fn check_settings(&self) -> Result<(), SolveError> {
+    pub(crate) fn check_settings(&self) -> Result<(), SolveError> {
         if !(1..=DIFFUSION_STEPS).contains(&self.steps) {
             return Err(SolveError::Invalid(format!(
                 "guide: {} steps; use 1..={DIFFUSION_STEPS}",
@@ -192,6 +198,11 @@ impl GuideConfig {
         if !(self.tau.is_finite() && self.tau >= 0.0 && self.variance_bound >= 0.0) {
             return Err(SolveError::Invalid(
                 "guide: τ and the variance bound must be finite and ≥ 0".into(),
+            ));
+        }
+        if !(self.realism_share.is_finite() && (0.0..=1.0).contains(&self.realism_share)) {
+            return Err(SolveError::Invalid(
+                "guide: realism_share (the share of steps the ControlNet steers) must be between 0 and 1".into(),
             ));
         }
         if !(self.smooth_frames.is_finite() && (0.0..=100.0).contains(&self.smooth_frames)) {
@@ -250,8 +261,17 @@ fn run(
     let mut trace = Vec::with_capacity(n);
     let mut realism = Realism::new(ctx, ctx.prior.control.filter(|_| cfg.realism));
     let mut steps = ctx.chain_steps(n);
+    // The first `steered` steps of the chain go through the ControlNet.
+    let steered = (cfg.realism_share as f64 * n as f64).ceil() as usize;
+    let steers = |i: usize| n.saturating_sub(1 + i) < steered;
     while let Some(i) = steps.next_step() {
-        let x0 = ctx.hold_x0(realism.x0(&den, x.clone(), schedule.timesteps[i], &cond));
+        let x0 = ctx.hold_x0(realism.x0(
+            &den,
+            x.clone(),
+            schedule.timesteps[i],
+            &cond,
+            steers(i),
+        ));
         let mut mu = posterior_mean(&schedule, i, x, x0);
         let k = cfg.iterations_at(i);
         let post = schedule.posterior(i);
@@ -260,7 +280,8 @@ fn run(
         let mut last = None;
         if k > 0 {
             let mut full = host(mu);
-            let before = realism.is_on().then(|| full.clone());
+            // The hint is for the next step: only worth deriving when it is steered.
+            let before = (realism.is_on() && i > 0 && steers(i - 1)).then(|| full.clone());
             let values = match &cfg.fused {
                 Some(fused) => {
                     let inner = Inner::at(cfg, fused, i, k, step);
@@ -674,6 +695,12 @@ impl SolverConfig for GuideConfig {
             "realism",
             "1: when the model has a ControlNet, every denoising step's x̂0 is steered by it with a hint taken from the program's gradient and the inner loop's iterate (OmniControl's realism guidance); 0: off",
             realism
+        ),
+        knob!(
+            Real,
+            "realism_share",
+            "share of the denoising steps, from the first (noisiest) on, whose x̂0 the ControlNet steers, 0–1; 1: every step, as OmniControl",
+            realism_share
         ),
         fused_knob!(Real, "late_root", "share of the root columns (path) in each step of the last `late_steps`, 0–1: the late steps meet contacts and keyframes with the pose instead of by moving the people; 1: OmniControl's plain gradient", late_root_scale),
     ];

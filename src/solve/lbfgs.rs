@@ -164,7 +164,7 @@ fn run(
     let early_mask = cfg.early_root_only.then(|| root_mask(&ctx.device));
     let mut realism = Realism::new(ctx, ctx.prior.control.filter(|_| cfg.realism));
     for i in (0..n).rev() {
-        let x0 = realism.x0(&den, x.clone(), schedule.timesteps[i], &cond);
+        let x0 = realism.x0(&den, x.clone(), schedule.timesteps[i], &cond, true);
         let mu = posterior_mean(&schedule, i, x, x0);
         let before = (realism.is_on() && (cfg.k_first > 0 || cfg.k_last > 0)).then(|| host(mu.clone()));
         let at = || format!("denoising step {}/{n}", n - i);

@@ -43,16 +43,17 @@ impl<'a> Realism<'a> {
         self.control.is_some()
     }
 
-    /// Classifier-free guided x̂0, through the ControlNet when there is one.
+    /// Classifier-free guided x̂0, through the ControlNet when there is one and `steer`.
     pub fn x0(
         &self,
         den: &crate::model::Mdm,
         x_t: Tensor<3>,
         t: usize,
         cond: &Condition,
+        steer: bool,
     ) -> Tensor<3> {
         match &self.control {
-            Some((control, hint)) => {
+            Some((control, hint)) if steer => {
                 let steered = Controlled {
                     base: den,
                     control,
@@ -60,7 +61,7 @@ impl<'a> Realism<'a> {
                 };
                 guided_x0(&steered as &dyn Denoiser, x_t, t, cond)
             }
-            None => guided_x0(den, x_t, t, cond),
+            _ => guided_x0(den, x_t, t, cond),
         }
     }
 
@@ -220,5 +221,54 @@ mod tests {
             plain.features, steered.features,
             "a zero ControlNet adds zero"
         );
+    }
+
+    #[test]
+    fn realism_share_steers_only_the_first_steps() {
+        let bundle = tiny_bundle();
+        let control =
+            ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
+        let base = GuideConfig {
+            steps: 20,
+            k_early: 2,
+            k_late: 5,
+            late_steps: 3,
+            ..GuideConfig::default()
+        };
+        let error: &dyn MotionError = &keyframes;
+        let go = |cfg: GuideConfig| {
+            let req = SolveRequest::new(
+                vec!["a person walks forward".into()],
+                FRAMES,
+                3,
+                Solver::new(cfg),
+            );
+            let prior = Prior::from_bundle(&bundle).with_control(Some(&control));
+            solve(&prior, &req, error, &Device::flex(), |_| {}).unwrap()
+        };
+        let off = go(GuideConfig {
+            realism: false,
+            ..base.clone()
+        });
+        let none = go(GuideConfig {
+            realism_share: 0.0,
+            ..base.clone()
+        });
+        let half = go(GuideConfig {
+            realism_share: 0.5,
+            ..base.clone()
+        });
+        let all = go(base.clone());
+        assert_eq!(off.features, none.features, "a share of 0 steers nothing");
+        assert_ne!(off.features, half.features, "a random ControlNet steers");
+        assert_ne!(
+            half.features, all.features,
+            "the later steps are steered too"
+        );
+        let bad = GuideConfig {
+            realism_share: 1.5,
+            ..base
+        };
+        assert!(bad.check_settings().is_err());
     }
 }
