@@ -193,17 +193,23 @@ mod tests {
         assert_eq!(free, 0.0);
     }
 
-    #[test]
-    fn a_fresh_control_net_leaves_guide_unchanged() {
-        let bundle = tiny_bundle();
-        let control = ControlNet::from_base(&bundle.model, &Device::flex());
-        let cfg = GuideConfig {
+    /// A short guided chain.
+    fn short_guide() -> GuideConfig {
+        GuideConfig {
             steps: 20,
             k_early: 2,
             k_late: 5,
             late_steps: 3,
             ..GuideConfig::default()
-        };
+        }
+    }
+
+    /// The keyframe program solved with `cfg`, steered by `control` when given.
+    fn guided(
+        bundle: &crate::model::ModelBundle,
+        cfg: GuideConfig,
+        control: Option<&ControlNet>,
+    ) -> crate::solve::SolveResult {
         let req = SolveRequest::new(
             vec!["a person walks forward".into()],
             FRAMES,
@@ -211,12 +217,16 @@ mod tests {
             Solver::new(cfg),
         );
         let error: &dyn MotionError = &keyframes;
-        let go = |control: Option<&ControlNet>| {
-            let prior = Prior::from_bundle(&bundle).with_control(control);
-            solve(&prior, &req, error, &Device::flex(), |_| {}).unwrap()
-        };
-        let plain = go(None);
-        let steered = go(Some(&control));
+        let prior = Prior::from_bundle(bundle).with_control(control);
+        solve(&prior, &req, error, &Device::flex(), |_| {}).unwrap()
+    }
+
+    #[test]
+    fn a_fresh_control_net_leaves_guide_unchanged() {
+        let bundle = tiny_bundle();
+        let control = ControlNet::from_base(&bundle.model, &Device::flex());
+        let plain = guided(&bundle, short_guide(), None);
+        let steered = guided(&bundle, short_guide(), Some(&control));
         assert_eq!(
             plain.features, steered.features,
             "a zero ControlNet adds zero"
@@ -228,24 +238,8 @@ mod tests {
         let bundle = tiny_bundle();
         let control =
             ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
-        let base = GuideConfig {
-            steps: 20,
-            k_early: 2,
-            k_late: 5,
-            late_steps: 3,
-            ..GuideConfig::default()
-        };
-        let error: &dyn MotionError = &keyframes;
-        let go = |cfg: GuideConfig| {
-            let req = SolveRequest::new(
-                vec!["a person walks forward".into()],
-                FRAMES,
-                3,
-                Solver::new(cfg),
-            );
-            let prior = Prior::from_bundle(&bundle).with_control(Some(&control));
-            solve(&prior, &req, error, &Device::flex(), |_| {}).unwrap()
-        };
+        let base = short_guide();
+        let go = |cfg: GuideConfig| guided(&bundle, cfg, Some(&control));
         let off = go(GuideConfig {
             realism: false,
             ..base.clone()
