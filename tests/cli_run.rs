@@ -235,6 +235,28 @@ fn eval_refuses_an_unknown_sampler_before_loading_anything() {
 }
 
 #[test]
+fn a_guidance_scale_that_is_not_a_sane_number_is_refused_by_name() {
+    for bad in ["nan", "-3", "inf", "1e9", "two"] {
+        for cmd in [
+            &["gen", "--text", "a person walks", "-o", "/tmp/never.npy"][..],
+            &["bench", "actions"][..],
+            &["eval", "--data", "/nonexistent"][..],
+        ] {
+            let mut args = cmd.to_vec();
+            args.extend(["--guidance", bad]);
+            let out = run(&args);
+            assert!(!out.status.success(), "{args:?}");
+            let (_, stderr) = text(&out);
+            assert!(stderr.contains("--guidance"), "{args:?}: {stderr}");
+            assert!(
+                stderr.contains("must lie in 0..=20") || stderr.contains("is not a number"),
+                "{args:?}: {stderr}"
+            );
+        }
+    }
+}
+
+#[test]
 fn a_bundle_with_a_controlnet_adds_guide_without_realism_to_the_task_table() {
     use burn::prelude::*;
     let dir = tempfile::tempdir().unwrap();

@@ -23,7 +23,7 @@ fn the_prior_performs_the_wider_actions() {
             return;
         }
     };
-    let rows = measure_actions(&bundle, &device, None).unwrap();
+    let rows = measure_actions(&bundle, &device, None, 2.5).unwrap();
     let table = actions_table(&rows);
     println!("model {}\n\n{table}", bundle.manifest.weights_id);
     let failed: Vec<&str> = rows

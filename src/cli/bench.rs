@@ -38,6 +38,9 @@ pub struct ActionBenchArgs {
     /// the model's length prior, the walk 6 s).
     #[arg(long)]
     seconds: Option<f32>,
+    /// Classifier-free guidance scale (`mprog gen`'s default).
+    #[arg(long, default_value_t = 2.5, value_parser = super::parse_guidance, allow_hyphen_values = true)]
+    guidance: f32,
 }
 
 fn bench_actions(args: ActionBenchArgs) -> Result<()> {
@@ -51,16 +54,18 @@ fn bench_actions(args: ActionBenchArgs) -> Result<()> {
     if let Some(s) = args.seconds {
         super::generate::seconds_to_frames(s)?;
     }
-    let rows = mprog::metrics::actions::measure_actions(&bundle, &device, args.seconds)
-        .into_diagnostic()?;
+    let rows =
+        mprog::metrics::actions::measure_actions(&bundle, &device, args.seconds, args.guidance)
+            .into_diagnostic()?;
     let length = match args.seconds {
         Some(s) => format!("{s} s"),
         None => "each prompt as long as `gen` makes it".to_string(),
     };
     println!(
-        "model {} ({}): {length}, DDIM 50, guidance 2.5, no cleanup; heights above the motion's lowest foot joint\n",
+        "model {} ({}): {length}, DDIM 50, guidance {}, no cleanup; heights above the motion's lowest foot joint\n",
         bundle.manifest.weights_id,
-        dir.display()
+        dir.display(),
+        args.guidance
     );
     print!("{}", mprog::metrics::actions::actions_table(&rows));
     Ok(())

@@ -34,6 +34,10 @@ pub struct SolverBenchArgs {
     /// Model bundle (default: the shipped model).
     #[arg(long)]
     model: Option<PathBuf>,
+    /// Only the plain DDPM chain and `guide`'s rows (with a ControlNet: with realism, without
+    /// it, and with OmniControl's ControlNet pass per step and guidance half).
+    #[arg(long)]
+    guide_only: bool,
     /// Time realism guidance with a zero-initialised ControlNet when the bundle has none:
     /// what it costs does not depend on its training.
     #[arg(long)]
@@ -134,7 +138,7 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
     let guided = run(
         Solver::new(guide.clone()),
         if control.is_some() {
-            "guide (fused inner loop, realism)"
+            "guide (fused inner loop, realism: one ControlNet pass per 2 steps)"
         } else {
             "guide (fused inner loop)"
         },
@@ -149,6 +153,57 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
         )?),
         None => None,
     };
+    let shared = match &control {
+        Some(_) => Some(run(
+            Solver::new(GuideConfig {
+                realism_shared: false,
+                realism_every: 1,
+                ..guide.clone()
+            }),
+            "guide (realism as OmniControl: a ControlNet pass per step and guidance half)",
+        )?),
+        None => None,
+    };
+    let mut md = String::new();
+    let _ = writeln!(md, "### Solver cost\n");
+    let frames = program.length();
+    let _ = writeln!(
+        md,
+        "- program: `{}` ({} frames = {:.1} s, {} person{}), seed {}",
+        args.program.display(),
+        frames,
+        frames as f32 / 20.0,
+        prompts.len(),
+        if prompts.len() == 1 { "" } else { "s" },
+        args.seed
+    );
+    let _ = writeln!(
+        md,
+        "- machine: {}; backend: {}",
+        mprog::backend::machine_description(),
+        mprog::backend::backend_name()
+    );
+    let _ = writeln!(md, "- weights: {}\n", bundle.manifest.weights_id);
+    let _ = writeln!(md, "| run | seconds | × its unguided sampler | error |");
+    let _ = writeln!(md, "| --- | --- | --- | --- |");
+    let row = |md: &mut String, t: &Timed, base: Option<&Timed>| {
+        let ratio = base.map_or("—".to_string(), |b| {
+            format!("{:.2}×", t.seconds / b.seconds)
+        });
+        let _ = writeln!(
+            md,
+            "| {} | {:.1} | {ratio} | {:.4} |",
+            t.label, t.seconds, t.error
+        );
+    };
+    row(&mut md, &plain_ddpm, None);
+    row(&mut md, &guided, Some(&plain_ddpm));
+    for t in no_realism.iter().chain(&shared) {
+        row(&mut md, t, Some(&plain_ddpm));
+    }
+    if args.guide_only {
+        return finish(md, args.out.as_deref());
+    }
     let tape = if args.skip_tape {
         None
     } else {
@@ -184,43 +239,6 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
     };
     let latent_fast = run(Solver::new(fast.clone()), "latent (10 × 30, lr 0.02)")?;
 
-    let frames = program.length();
-    let mut md = String::new();
-    let _ = writeln!(md, "### Solver cost\n");
-    let _ = writeln!(
-        md,
-        "- program: `{}` ({} frames = {:.1} s, {} person{}), seed {}",
-        args.program.display(),
-        frames,
-        frames as f32 / 20.0,
-        prompts.len(),
-        if prompts.len() == 1 { "" } else { "s" },
-        args.seed
-    );
-    let _ = writeln!(
-        md,
-        "- machine: {}; backend: {}",
-        mprog::backend::machine_description(),
-        mprog::backend::backend_name()
-    );
-    let _ = writeln!(md, "- weights: {}\n", bundle.manifest.weights_id);
-    let _ = writeln!(md, "| run | seconds | × its unguided sampler | error |");
-    let _ = writeln!(md, "| --- | --- | --- | --- |");
-    let row = |md: &mut String, t: &Timed, base: Option<&Timed>| {
-        let ratio = base.map_or("—".to_string(), |b| {
-            format!("{:.2}×", t.seconds / b.seconds)
-        });
-        let _ = writeln!(
-            md,
-            "| {} | {:.1} | {ratio} | {:.4} |",
-            t.label, t.seconds, t.error
-        );
-    };
-    row(&mut md, &plain_ddpm, None);
-    row(&mut md, &guided, Some(&plain_ddpm));
-    if let Some(t) = &no_realism {
-        row(&mut md, t, Some(&plain_ddpm));
-    }
     if let Some(t) = &tape {
         row(&mut md, t, Some(&plain_ddpm));
     }
@@ -245,8 +263,13 @@ pub fn run(args: SolverBenchArgs) -> Result<()> {
             " (measured)".to_string()
         }
     );
+    finish(md, args.out.as_deref())
+}
+
+/// Prints the table and writes it to `out` (atomically) when asked.
+fn finish(md: String, out: Option<&std::path::Path>) -> Result<()> {
     print!("{md}");
-    if let Some(path) = &args.out {
+    if let Some(path) = out {
         mprog::fsutil::write_bytes_atomic(path, md.as_bytes())
             .into_diagnostic()
             .wrap_err_with(|| format!("cannot write {}", path.display()))?;

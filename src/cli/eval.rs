@@ -58,7 +58,7 @@ struct RunArgs {
     #[arg(long, alias = "ddim-steps")]
     steps: Option<usize>,
     /// Classifier-free guidance scale.
-    #[arg(long, default_value_t = 2.5)]
+    #[arg(long, default_value_t = 2.5, value_parser = super::parse_guidance, allow_hyphen_values = true)]
     guidance: f32,
     /// Motions generated per call.
     #[arg(long, default_value_t = 16)]

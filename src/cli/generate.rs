@@ -41,7 +41,7 @@ pub struct GenArgs {
     #[arg(long)]
     steps: Option<usize>,
     /// Classifier-free guidance scale.
-    #[arg(long, default_value_t = 2.5)]
+    #[arg(long, default_value_t = 2.5, value_parser = super::parse_guidance, allow_hyphen_values = true)]
     guidance: f32,
     /// Average every denoising step with its left/right mirror (swapped sides in the
     /// motion and the prompt): left and right turns become exact mirrors; twice the work.

@@ -1,5 +1,5 @@
 //! What the motion prior does with named actions (issue 28's "done when"): each prompt is
-//! generated with seeds 1 and 2 (DDIM 50, guidance 2.5, no cleanup) and one number is read
+//! generated with seeds 1 and 2 (DDIM 50, guidance 2.5 unless told, no cleanup) and one number is read
 //! off the motion against a threshold. `mprog bench actions` prints the table.
 //!
 //! Each prompt is as long as `mprog gen` makes it by default: the model's length prior
@@ -223,12 +223,14 @@ impl ActionRow {
     }
 }
 
-/// Generates every case with seeds 1 and 2 and measures it; `seconds` pins every case's
-/// length (else each has its own, see the module's notes).
+/// Generates every case with seeds 1 and 2 at classifier-free guidance `guidance` and
+/// measures it; `seconds` pins every case's length (else each has its own, see the
+/// module's notes).
 pub fn measure_actions(
     bundle: &ModelBundle,
     device: &Device,
     seconds: Option<f32>,
+    guidance: f32,
 ) -> Result<Vec<ActionRow>, GenerateError> {
     CASES
         .iter()
@@ -247,7 +249,7 @@ pub fn measure_actions(
                     frames,
                     seed,
                     sampler: SamplerKind::Ddim(50),
-                    guidance_scale: 2.5,
+                    guidance_scale: guidance,
                     mirror_average: false,
                 };
                 let out = generate(bundle, &req, device, |_, _| {})?;

@@ -177,19 +177,77 @@ pub struct Controlled<'a> {
     pub control: &'a ControlNet,
     /// What to steer towards (one row per sample of the solve).
     pub hint: Hint,
+    /// When the batch is a classifier-free guidance pair (conditioned samples first, then
+    /// the same samples without text, as [`crate::model::sampler::guided_x0`] stacks
+    /// them): run the ControlNet on the conditioned half only and add its output to both
+    /// halves. Half the ControlNet's cost; OmniControl runs it on each half.
+    pub shared_guidance: bool,
+}
+
+impl Controlled<'_> {
+    /// x̂0 for `input`, and the ControlNet's additions it used (one `[B, N+1, d]` per base
+    /// layer), which [`WithControls`] can reuse.
+    pub fn predict_x0_and_controls(&self, input: &DenoiserInput) -> (Tensor<3>, Vec<Tensor<3>>) {
+        let (seq, mask) = self.base.embed(input);
+        let batch = seq.dims()[0];
+        let own = self.hint.values.dims()[0];
+        let controls: Vec<Tensor<3>> = if self.shared_guidance && batch == 2 * own {
+            let half = |m: Tensor<2, Bool>| m.narrow(0, 0, own);
+            self.control
+                .controls(
+                    seq.clone().narrow(0, 0, own),
+                    self.hint.values.clone(),
+                    mask.clone().map(half),
+                )
+                .into_iter()
+                .map(|c| Tensor::cat(vec![c.clone(), c], 0))
+                .collect()
+        } else {
+            let hint = self.hint.for_batch(batch);
+            self.control.controls(seq.clone(), hint, mask.clone())
+        };
+        let x0 = with_controls(self.base, seq, mask, &controls, input);
+        (x0, controls)
+    }
 }
 
 impl Denoiser for Controlled<'_> {
     fn predict_x0(&self, input: &DenoiserInput) -> Tensor<3> {
-        let (seq, mask) = self.base.embed(input);
-        let hint = self.hint.for_batch(seq.dims()[0]);
-        let controls = self.control.controls(seq.clone(), hint, mask.clone());
-        let mut x = seq;
-        for (layer, add) in self.base.encoder().layers.iter().zip(controls) {
-            x = layer.forward(x, mask.clone(), None) + add;
-        }
-        self.base.output(x, input)
+        self.predict_x0_and_controls(input).0
     }
+}
+
+/// The frozen denoiser with a ControlNet's additions computed earlier (for a batch of the
+/// same size): a step that reuses the previous step's steering without running the
+/// ControlNet again.
+pub struct WithControls<'a> {
+    /// The frozen denoiser.
+    pub base: &'a Mdm,
+    /// One `[B, N+1, d]` per layer, from [`Controlled::predict_x0_and_controls`].
+    pub controls: &'a [Tensor<3>],
+}
+
+impl Denoiser for WithControls<'_> {
+    fn predict_x0(&self, input: &DenoiserInput) -> Tensor<3> {
+        let (seq, mask) = self.base.embed(input);
+        with_controls(self.base, seq, mask, self.controls, input)
+    }
+}
+
+/// The base's encoder over the embedded `seq` with `controls` added after each layer, and
+/// its output head.
+fn with_controls(
+    base: &Mdm,
+    seq: Tensor<3>,
+    mask: Option<Tensor<2, Bool>>,
+    controls: &[Tensor<3>],
+    input: &DenoiserInput,
+) -> Tensor<3> {
+    let mut x = seq;
+    for (layer, add) in base.encoder().layers.iter().zip(controls) {
+        x = layer.forward(x, mask.clone(), None) + add.clone();
+    }
+    base.output(x, input)
 }
 
 #[cfg(test)]
@@ -251,6 +309,7 @@ mod tests {
             base: &base,
             control: &control,
             hint: hint(2, 6, &dev),
+            shared_guidance: false,
         };
         assert_eq!(
             max_diff(steered.predict_x0(&input), base.predict_x0(&input)),
@@ -279,6 +338,7 @@ mod tests {
                 base: &base,
                 control: &control,
                 hint: h,
+                shared_guidance: false,
             }
             .predict_x0(&input)
         };
@@ -286,6 +346,78 @@ mod tests {
         let steered = with(hint(1, 6, &dev));
         assert!(max_diff(empty.clone(), steered) > 1e-4);
         assert!(max_diff(empty, base.predict_x0(&input)) > 1e-4);
+    }
+
+    #[test]
+    fn a_shared_control_steers_both_guidance_halves_with_the_conditioned_pass() {
+        let dev = Device::flex();
+        let base = Mdm::new(&config(32), vocab().len(), &dev).valid();
+        let control = ControlNet::from_base(&base, &dev).map(&mut Randomise(NoiseSource::new(3)));
+        let input = question(2, 6, &dev);
+        // A guidance pair: the samples with their text, then without.
+        let pair = DenoiserInput {
+            x_t: Tensor::cat(vec![input.x_t.clone(); 2], 0),
+            timesteps: vec![400; 4],
+            text: input.text.doubled(),
+            keep_text: Tensor::from_floats([1.0, 1.0, 0.0, 0.0], &dev),
+            padding: None,
+        };
+        let run = |shared_guidance| {
+            Controlled {
+                base: &base,
+                control: &control,
+                hint: hint(2, 6, &dev),
+                shared_guidance,
+            }
+            .predict_x0(&pair)
+        };
+        let (own, shared) = (run(false), run(true));
+        // The conditioned half is the same either way; the unconditioned half differs,
+        // because its ControlNet pass read the text-free token before.
+        let half = |t: Tensor<3>, h: usize| t.narrow(0, 2 * h, 2);
+        assert!(max_diff(half(own.clone(), 0), half(shared.clone(), 0)) < 1e-5);
+        assert!(max_diff(half(own, 1), half(shared.clone(), 1)) > 1e-4);
+        // It is the base's text-free pass plus the conditioned pass's controls.
+        let embedded = base.embed(&pair);
+        let controls = control.controls(
+            embedded.0.clone().narrow(0, 0, 2),
+            hint(2, 6, &dev).values,
+            None,
+        );
+        let mut x = embedded.0.narrow(0, 2, 2);
+        for (layer, add) in base.encoder().layers.iter().zip(controls) {
+            x = layer.forward(x, None, None) + add;
+        }
+        let uncond = DenoiserInput {
+            x_t: input.x_t.clone(),
+            timesteps: vec![400; 2],
+            text: input.text.clone(),
+            keep_text: Tensor::zeros([2], &dev),
+            padding: None,
+        };
+        assert!(max_diff(base.output(x, &uncond), half(shared, 1)) < 1e-5);
+    }
+
+    #[test]
+    fn reused_controls_give_the_steered_prediction_without_the_control_net() {
+        let dev = Device::flex();
+        let base = Mdm::new(&config(32), vocab().len(), &dev).valid();
+        let control = ControlNet::from_base(&base, &dev).map(&mut Randomise(NoiseSource::new(5)));
+        let input = question(2, 6, &dev);
+        let steered = Controlled {
+            base: &base,
+            control: &control,
+            hint: hint(2, 6, &dev),
+            shared_guidance: false,
+        };
+        let (x0, controls) = steered.predict_x0_and_controls(&input);
+        assert_eq!(controls.len(), 2, "one per base layer");
+        let reused = WithControls {
+            base: &base,
+            controls: &controls,
+        };
+        assert_eq!(max_diff(reused.predict_x0(&input), x0.clone()), 0.0);
+        assert!(max_diff(base.predict_x0(&input), x0) > 1e-4);
     }
 
     #[test]
@@ -309,6 +441,7 @@ mod tests {
                 base: &base,
                 control: c,
                 hint: hint(1, 5, &dev),
+                shared_guidance: false,
             }
             .predict_x0(&input)
         };

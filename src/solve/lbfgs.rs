@@ -81,6 +81,12 @@ pub struct LbfgsConfig {
     /// Steer every denoising step through the prior's ControlNet with a hint derived from
     /// the program, as `guide` does ([`super::realism`]); acts only with a ControlNet.
     pub realism: bool,
+    /// One ControlNet pass per step for both halves of classifier-free guidance, as
+    /// `guide`'s knob of the same name.
+    pub realism_shared: bool,
+    /// The ControlNet runs on every k-th step, the steps between reuse its additions, as
+    /// `guide`'s knob of the same name.
+    pub realism_every: usize,
 }
 
 impl Default for LbfgsConfig {
@@ -97,6 +103,8 @@ impl Default for LbfgsConfig {
             early_root_only: false,
             smooth_frames: 4.0,
             realism: true,
+            realism_shared: true,
+            realism_every: 2,
         }
     }
 }
@@ -111,6 +119,11 @@ impl LbfgsConfig {
             return Err(SolveError::Invalid(format!(
                 "lbfgs: need 1..={DIFFUSION_STEPS} steps, history ≥ 1, max_iter ≥ 1 and a positive learning rate"
             )));
+        }
+        if !(1..=100).contains(&self.realism_every) {
+            return Err(SolveError::Invalid(
+                "lbfgs: realism_every (how often the ControlNet runs) must be 1..=100 steps".into(),
+            ));
         }
         if !(self.smooth_frames.is_finite() && (0.0..=100.0).contains(&self.smooth_frames)) {
             return Err(SolveError::Invalid(
@@ -162,7 +175,12 @@ fn run(
     let mut x = ctx.initial_tensor(&ctx.device);
     let mut trace = Vec::with_capacity(n);
     let early_mask = cfg.early_root_only.then(|| root_mask(&ctx.device));
-    let mut realism = Realism::new(ctx, ctx.prior.control.filter(|_| cfg.realism));
+    let mut realism = Realism::new(
+        ctx,
+        ctx.prior.control.filter(|_| cfg.realism),
+        cfg.realism_shared,
+        cfg.realism_every,
+    );
     for i in (0..n).rev() {
         let x0 = realism.x0(&den, x.clone(), schedule.timesteps[i], &cond, true);
         let mu = posterior_mean(&schedule, i, x, x0);
@@ -434,6 +452,18 @@ impl SolverConfig for LbfgsConfig {
             "realism",
             "1: when the model has a ControlNet, every denoising step's x̂0 is steered by it with a hint from the program (as guide's); 0: off",
             realism
+        ),
+        knob!(
+            Count,
+            "realism_every",
+            "the ControlNet runs on every k-th step, the steps between reuse its additions; 1: every step",
+            realism_every
+        ),
+        knob!(
+            Flag("a pass per half, as OmniControl", "one pass for both halves"),
+            "realism_shared",
+            "1: the ControlNet runs once per step, on the text-conditioned half of classifier-free guidance, and steers both halves (half its cost); 0: a pass per half",
+            realism_shared
         ),
         knob!(Count, "k_first", "L-BFGS `step` calls per denoising step before the last `late_steps`", k_first),
         knob!(Count, "k_last", "`step` calls on each of the last `late_steps` (InterControl's 10; the smoothed late steps need more for one-frame targets)", k_last),

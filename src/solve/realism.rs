@@ -13,28 +13,67 @@
 //!   frame (the model's own).
 //!
 //! The first step has no hint (nothing is known yet); each later step uses the hint of the
-//! step before. A keyframe program's hint is its keyframes: its joints, on its frames, at
+//! step before. A step whose hint controls nothing (the first, or every statement met) is
+//! not steered at all: the ControlNet was trained with at least one hinted frame, and an
+//! empty hint is a question it never saw. A keyframe program's hint is its keyframes: its joints, on its frames, at
 //! the places the inner loop put them (the targets, once it has met them).
 
 use super::SolveError;
 use super::driver::{Ctx, host};
 use crate::features::recover_from_ric_tensor;
 use crate::model::Denoiser;
-use crate::model::control::{ControlNet, Controlled, Hint};
+use crate::model::control::{ControlNet, Controlled, Hint, WithControls};
+use crate::model::denoiser::DenoiserInput;
 use crate::model::sampler::{Condition, guided_x0};
 use crate::skeleton::NUM_JOINTS;
 use burn::prelude::*;
+use std::cell::RefCell;
 
 /// The steering of one guided chain: the ControlNet and the current hint, or nothing.
 pub struct Realism<'a> {
     control: Option<(&'a ControlNet, Hint)>,
+    /// Whether the current hint controls any joint on any frame.
+    hinted: bool,
+    /// One ControlNet pass per step, on the text-conditioned half of classifier-free
+    /// guidance, steering both halves ([`Controlled::shared_guidance`]).
+    shared_guidance: bool,
+    /// The ControlNet runs on every `every`-th steered step; the steps between reuse its
+    /// additions.
+    every: usize,
+    /// The last ControlNet additions, and the steered steps since they were computed.
+    cached: Option<(Vec<Tensor<3>>, usize)>,
+}
+
+/// The steered denoiser, keeping the ControlNet's additions of its call.
+struct Recording<'a> {
+    steered: Controlled<'a>,
+    controls: RefCell<Option<Vec<Tensor<3>>>>,
+}
+
+impl Denoiser for Recording<'_> {
+    fn predict_x0(&self, input: &DenoiserInput) -> Tensor<3> {
+        let (x0, controls) = self.steered.predict_x0_and_controls(input);
+        *self.controls.borrow_mut() = Some(controls);
+        x0
+    }
 }
 
 impl<'a> Realism<'a> {
-    /// Steering with `control` when given (the hint starts empty), else none.
-    pub fn new(ctx: &Ctx, control: Option<&'a ControlNet>) -> Realism<'a> {
+    /// Steering with `control` when given (the hint starts empty), else none;
+    /// `shared_guidance`: see [`Controlled::shared_guidance`]; the ControlNet runs on every
+    /// `every`-th steered step (1: each), the others reuse its last additions.
+    pub fn new(
+        ctx: &Ctx,
+        control: Option<&'a ControlNet>,
+        shared_guidance: bool,
+        every: usize,
+    ) -> Realism<'a> {
         Realism {
             control: control.map(|c| (c, Hint::empty(ctx.motions(), ctx.frames, &ctx.device))),
+            hinted: false,
+            shared_guidance,
+            every: every.max(1),
+            cached: None,
         }
     }
 
@@ -43,26 +82,44 @@ impl<'a> Realism<'a> {
         self.control.is_some()
     }
 
-    /// Classifier-free guided x̂0, through the ControlNet when there is one and `steer`.
+    /// Classifier-free guided x̂0, through the ControlNet when there is one, `steer`, and
+    /// the hint controls something; a step within `every` of the last ControlNet pass
+    /// reuses that pass's additions.
     pub fn x0(
-        &self,
+        &mut self,
         den: &crate::model::Mdm,
         x_t: Tensor<3>,
         t: usize,
         cond: &Condition,
         steer: bool,
     ) -> Tensor<3> {
-        match &self.control {
-            Some((control, hint)) if steer => {
-                let steered = Controlled {
-                    base: den,
-                    control,
-                    hint: hint.clone(),
-                };
-                guided_x0(&steered as &dyn Denoiser, x_t, t, cond)
-            }
-            _ => guided_x0(den, x_t, t, cond),
+        let Some((control, hint)) = self.control.as_ref().filter(|_| steer && self.hinted) else {
+            // An unsteered step ends the reuse: the next steered step runs the ControlNet.
+            self.cached = None;
+            return guided_x0(den, x_t, t, cond);
+        };
+        if let Some((controls, age)) = &mut self.cached
+            && *age < self.every
+        {
+            *age += 1;
+            let reused = WithControls {
+                base: den,
+                controls,
+            };
+            return guided_x0(&reused as &dyn Denoiser, x_t, t, cond);
         }
+        let recording = Recording {
+            steered: Controlled {
+                base: den,
+                control,
+                hint: hint.clone(),
+                shared_guidance: self.shared_guidance,
+            },
+            controls: RefCell::new(None),
+        };
+        let x0 = guided_x0(&recording as &dyn Denoiser, x_t, t, cond);
+        self.cached = recording.controls.into_inner().map(|c| (c, 1));
+        x0
     }
 
     /// After a step's inner loop moved μ from `before` to `after` (host `[B·P, N, 263]`,
@@ -70,6 +127,8 @@ impl<'a> Realism<'a> {
     pub fn update(&mut self, ctx: &Ctx, before: &[f32], after: &[f32]) -> Result<(), SolveError> {
         if let Some((_, hint)) = &mut self.control {
             *hint = program_hint(ctx, before, after)?;
+            let mask = hint.values.clone().narrow(2, NUM_JOINTS * 3, NUM_JOINTS);
+            self.hinted = mask.sum().into_scalar::<f32>() > 0.0;
         }
         Ok(())
     }
@@ -231,6 +290,94 @@ mod tests {
             plain.features, steered.features,
             "a zero ControlNet adds zero"
         );
+    }
+
+    #[test]
+    fn a_met_program_gives_no_hint_and_is_not_steered() {
+        let bundle = tiny_bundle();
+        let control =
+            ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
+        // Every ankle above −100 m: met everywhere, so its gradient is zero.
+        let met = |j: Tensor<5>| {
+            let [b, _, _, _, _] = j.dims();
+            let ankle = j.narrow(3, 8, 1).narrow(4, 1, 1);
+            (ankle.neg() - 100.0).clamp_min(0.0).sum_dim(2).reshape([b])
+        };
+        let solve_with = |realism| {
+            let req = SolveRequest::new(
+                vec!["a person walks forward".into()],
+                FRAMES,
+                3,
+                Solver::new(GuideConfig {
+                    realism,
+                    ..short_guide()
+                }),
+            );
+            let error: &dyn MotionError = &met;
+            let prior = Prior::from_bundle(&bundle).with_control(Some(&control));
+            solve(&prior, &req, error, &Device::flex(), |_| {}).unwrap()
+        };
+        assert_eq!(solve_with(true).features, solve_with(false).features);
+    }
+
+    #[test]
+    fn a_shared_pass_steers_differently_from_a_pass_per_half() {
+        let bundle = tiny_bundle();
+        let control =
+            ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
+        let go = |realism_shared| {
+            guided(
+                &bundle,
+                GuideConfig {
+                    realism_shared,
+                    ..short_guide()
+                },
+                Some(&control),
+            )
+        };
+        // Guidance 2.5: the text-free half is steered by the conditioned pass's controls.
+        let (shared, own) = (go(true), go(false));
+        assert_ne!(shared.features, own.features);
+        assert!(shared.features.iter().all(|v| v.is_finite()));
+    }
+
+    #[test]
+    fn reusing_the_control_nets_additions_between_passes_changes_the_steering_a_little() {
+        let bundle = tiny_bundle();
+        let control =
+            ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
+        let go = |realism_every| {
+            guided(
+                &bundle,
+                GuideConfig {
+                    realism_every,
+                    ..short_guide()
+                },
+                Some(&control),
+            )
+        };
+        let off = guided(
+            &bundle,
+            GuideConfig {
+                realism: false,
+                ..short_guide()
+            },
+            Some(&control),
+        );
+        let (each, second, once) = (go(1), go(2), go(100));
+        assert_ne!(each.features, second.features, "reused additions are stale");
+        assert_ne!(second.features, once.features);
+        assert_ne!(
+            once.features, off.features,
+            "one pass still steers every step"
+        );
+        // Reuse is deterministic.
+        assert_eq!(go(2).features, second.features);
+        let bad = GuideConfig {
+            realism_every: 0,
+            ..short_guide()
+        };
+        assert!(bad.check_settings().is_err());
     }
 
     #[test]

@@ -10,7 +10,13 @@
 //! <out>/ckpt/control.safetensors, optim.bpk   the training state (f32)
 //! <out>/bundle/               the base bundle's files plus control.safetensors (f16)
 //! <out>/loss.csv              step, loss, learning rate, seconds
+//! <out>/val.csv               step, hint error with / without the ControlNet (m), seconds
 //! ```
+//!
+//! The training loss is the x0 error of all 263 features, of which a hint touches few, so
+//! it barely moves while the ControlNet learns. What it is trained for is measured at
+//! every checkpoint instead: on fixed validation crops with fixed hints, how far the hinted
+//! joints of x̂0 lie from their targets, steered and not (`val.csv`).
 
 use super::checkpoint::swap_in;
 use super::log::append;
@@ -21,7 +27,7 @@ use crate::dataset::{ClipInfo, Dataset, Split};
 use crate::features::recover_from_ric_tensor;
 use crate::fsutil::write_bytes_atomic;
 use crate::interrupt::Interrupt;
-use crate::model::batch::{draw_batch, step_rng};
+use crate::model::batch::{HostBatch, draw_batch, step_rng};
 use crate::model::config::TrainConfig;
 use crate::model::control::{CONTROL_FILE, ControlNet, Controlled, Hint};
 use crate::model::denoiser::{Denoiser, Mdm};
@@ -196,18 +202,14 @@ impl ControlTrainRun<'_> {
             let batch = draw_batch(self.data, &train, &batches, step);
             let (mut input, x0, valid) = to_device(&batch, &text, &device);
             let joints = recover_from_ric_tensor(x0.clone() * std.clone() + mean.clone());
-            let lengths: Vec<usize> = batch
-                .padding
-                .chunks(batch.frames)
-                .map(|p| p.iter().filter(|&&pad| !pad).count())
-                .collect();
             let mut rng = step_rng(cfg.seed ^ 0xC0_17_20_1E, step);
-            let hint = training_hint(joints, &lengths, &mut rng);
+            let hint = training_hint(joints, &valid_lengths(&batch), &mut rng);
             input.x_t = q_sample(&schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
             let pred = Controlled {
                 base: &base,
                 control: &ck.control,
                 hint,
+                shared_guidance: false,
             }
             .predict_x0(&input);
             let loss = masked_mse(pred, x0, valid);
@@ -238,6 +240,7 @@ impl ControlTrainRun<'_> {
                     &pending,
                 )?;
                 pending.clear();
+                self.log_validation(&base, &ck, &text, &schedule, (&mean, &std))?;
                 self.save(&ck)?;
                 saved_at = ck.state.step;
                 clock = Instant::now();
@@ -253,6 +256,76 @@ impl ControlTrainRun<'_> {
             self.save(&ck)?;
         }
         Ok(ck.state)
+    }
+
+    /// Mean distance (m) from the hinted joints of x̂0 to their targets on fixed
+    /// validation crops and hints, with the ControlNet and with the base alone; None
+    /// without validation clips.
+    pub fn hint_errors(
+        &self,
+        base: &Mdm,
+        control: &ControlNet,
+        text: &TrainText,
+        schedule: &NoiseSchedule,
+        (mean, std): (&Tensor<3>, &Tensor<3>),
+    ) -> Option<(f32, f32)> {
+        let clips: Vec<&ClipInfo> = self.data.clips(Split::Val).collect();
+        if clips.is_empty() {
+            return None;
+        }
+        let mut cfg = self.config.batches();
+        cfg.cond_drop = 0.0;
+        cfg.word_drop = 0.0;
+        let device = mean.device();
+        // Evaluation mode: no dropout in either network.
+        let (base, control) = (&base.clone().freeze(), &control.clone().freeze());
+        let (mut steered, mut alone) = (0.0, 0.0);
+        let rounds = 2;
+        for r in 0..rounds {
+            // Fixed "steps" far beyond any real step keep the crops, noise and hints fixed.
+            let batch = draw_batch(self.data, &clips, &cfg, usize::MAX - r);
+            let (mut input, x0, _) = to_device(&batch, text, &device);
+            let joints = recover_from_ric_tensor(x0.clone() * std.clone() + mean.clone());
+            let mut rng = step_rng(cfg.seed ^ 0x7A_11D, r);
+            let hint = training_hint(joints, &valid_lengths(&batch), &mut rng);
+            input.x_t = q_sample(schedule, x0, &batch.timesteps, batch.noise_seed);
+            let error = |pred: Tensor<3>| {
+                let joints = recover_from_ric_tensor(pred * std.clone() + mean.clone());
+                hint_distance(joints, &hint)
+            };
+            steered += error(
+                Controlled {
+                    base,
+                    control,
+                    hint: hint.clone(),
+                    shared_guidance: false,
+                }
+                .predict_x0(&input),
+            );
+            alone += error(base.predict_x0(&input));
+        }
+        Some((steered / rounds as f32, alone / rounds as f32))
+    }
+
+    fn log_validation(
+        &self,
+        base: &Mdm,
+        ck: &ControlState,
+        text: &TrainText,
+        schedule: &NoiseSchedule,
+        stats: (&Tensor<3>, &Tensor<3>),
+    ) -> Result<(), TrainError> {
+        if let Some((steered, alone)) = self.hint_errors(base, &ck.control, text, schedule, stats) {
+            append(
+                &self.out.join("val.csv"),
+                "step,hint_err_control,hint_err_base,seconds\n",
+                &format!(
+                    "{},{steered},{alone},{:.1}\n",
+                    ck.state.step, ck.state.seconds
+                ),
+            )?;
+        }
+        Ok(())
     }
 
     /// The ControlNet learns to steer the base as it was trained: on data normalised with
@@ -278,7 +351,8 @@ impl ControlTrainRun<'_> {
         let fresh = Mdm::new(&bundle.config, vocab_size, device);
         let base = model_from_safetensors(fresh, bytes, bundle.manifest.half_precision)
             .map_err(|e| file_err(&path, e))?;
-        // Dropout off, no gradients: the base is a fixed function here.
+        // No gradients; its dropout stays on, as OmniControl and InterControl train with
+        // the whole model in train mode (their frozen MDM included).
         Ok(base.no_grad())
     }
 
@@ -336,6 +410,31 @@ impl ControlTrainRun<'_> {
             .save(&bundle, true)
             .map_err(|e| file_err(&bundle, e))
     }
+}
+
+/// Valid (not padding) frames of each clip of a batch.
+fn valid_lengths(batch: &HostBatch) -> Vec<usize> {
+    batch
+        .padding
+        .chunks(batch.frames)
+        .map(|p| p.iter().filter(|&&pad| !pad).count())
+        .collect()
+}
+
+/// Mean distance (m) between the joints `[B, N, 22, 3]` and the hint's targets, over the
+/// hint's controlled joint-frames.
+pub fn hint_distance(joints: Tensor<4>, hint: &Hint) -> f32 {
+    let [b, n, j, _] = joints.dims();
+    let values = hint.values.clone();
+    let targets = values.clone().narrow(2, 0, j * 3).reshape([b, n, j, 3]);
+    let mask = values.narrow(2, j * 3, j);
+    let dist = (joints - targets)
+        .powi_scalar(2)
+        .sum_dim(3)
+        .sqrt()
+        .reshape([b, n, j]);
+    let hinted = mask.clone().sum().into_scalar::<f32>();
+    (dist * mask).sum().into_scalar::<f32>() / hinted.max(1.0)
 }
 
 fn stat(v: &[f32], device: &Device) -> Tensor<3> {
@@ -452,6 +551,27 @@ mod tests {
         assert_eq!(run(4).run(&|_, _, _| {}).unwrap().step, 10, "resumed");
         let csv = std::fs::read_to_string(out.path().join("loss.csv")).unwrap();
         assert_eq!(csv.lines().count(), 1 + 10);
+        // Every checkpoint (steps 4, 6, 8, 10) measured the hint error, steered and not.
+        let val = std::fs::read_to_string(out.path().join("val.csv")).unwrap();
+        let rows: Vec<Vec<f32>> = val
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(
+            rows.iter().map(|r| r[0] as usize).collect::<Vec<_>>(),
+            [4, 6, 8, 10]
+        );
+        for r in &rows {
+            assert!(
+                r[1].is_finite() && r[1] > 0.0 && r[2].is_finite() && r[2] > 0.0,
+                "{r:?}"
+            );
+            assert_eq!(
+                r[2], rows[0][2],
+                "the base alone sees the same crops every time"
+            );
+        }
         // The base is untouched; the exported bundle is the base plus a ControlNet that
         // has learned something (its zero layers moved).
         assert_eq!(
@@ -466,6 +586,58 @@ mod tests {
         let fresh = ControlNet::from_base(&bundle.model, &dev);
         let bytes = |c: &ControlNet| crate::model::weights::module_to_safetensors(c, true).unwrap();
         assert_ne!(bytes(&control), bytes(&fresh));
+    }
+
+    #[test]
+    fn hint_distance_is_measured_on_the_hinted_joint_frames_only() {
+        let dev = Device::flex();
+        let targets = crate::model::noise::NoiseSource::new(2).tensor([2, 4, NUM_JOINTS, 3], &dev);
+        let mut mask = vec![0.0f32; 2 * 4 * NUM_JOINTS];
+        mask[NUM_JOINTS + 10] = 1.0; // sample 0, frame 1, left foot
+        mask[(4 + 3) * NUM_JOINTS + 20] = 1.0; // sample 1, frame 3, left wrist
+        let hint = Hint::new(
+            targets.clone(),
+            Tensor::from_data(TensorData::new(mask, [2, 4, NUM_JOINTS]), &dev),
+        );
+        assert!(hint_distance(targets.clone(), &hint) < 1e-6);
+        // Every joint 3-4-0 cm off (5 cm): the hinted two count, the rest do not matter.
+        let shift = Tensor::<1>::from_floats([0.03, 0.04, 0.0], &dev).reshape([1, 1, 1, 3]);
+        let d = hint_distance(targets + shift, &hint);
+        assert!((d - 0.05).abs() < 1e-5, "{d}");
+    }
+
+    #[test]
+    fn a_fresh_control_net_leaves_the_hint_error_of_the_base() {
+        let data = synthetic_dataset();
+        let base_run = train_tiny_base(&data, 2, 1);
+        let dir = base_run.path().join("bundle");
+        let dev = Device::flex();
+        let bundle = ModelBundle::load(&dir, &dev).unwrap();
+        let run = ControlTrainRun {
+            data: &data,
+            base: dir,
+            config: ControlTrainConfig {
+                batch_size: 2,
+                crop_frames: 8,
+                ..ControlTrainConfig::default()
+            },
+            out: base_run.path().join("control"),
+            max_steps_now: Some(1),
+            interrupt: Default::default(),
+            device: dev.clone(),
+        };
+        let text = match &bundle.text {
+            PromptEncoder::Words(v) => TrainText::Words(v.clone()),
+            PromptEncoder::Sentences(_) => unreachable!("the tiny base reads words"),
+        };
+        let (mean, std) = (stat(&bundle.mean, &dev), stat(&bundle.std, &dev));
+        let fresh = ControlNet::from_base(&bundle.model, &dev);
+        let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
+        let (steered, alone) = run
+            .hint_errors(&bundle.model, &fresh, &text, &schedule, (&mean, &std))
+            .unwrap();
+        assert!(alone > 0.0);
+        assert_eq!(steered, alone);
     }
 
     #[test]
