@@ -61,6 +61,7 @@ pub fn run(args: TrainControlArgs) -> Result<()> {
         max_steps_now: args.steps,
         interrupt: interrupt.clone(),
         device: super::device()?,
+        after_checkpoint: Some(plot_hint_errors),
     };
     let state = run
         .run(&|state, loss, lr| {
@@ -85,6 +86,31 @@ pub fn run(args: TrainControlArgs) -> Result<()> {
         args.out.join("bundle").display()
     );
     Ok(())
+}
+
+/// `<out>/hint.png`: how far the hinted joints of x̂0 lie from their targets on the
+/// validation crops, with the ControlNet and with the base alone (`val.csv`).
+fn plot_hint_errors(out: &std::path::Path) -> Result<(), String> {
+    let val = out.join("val.csv");
+    let series = vec![
+        mprog::render::Series {
+            name: "with the ControlNet".into(),
+            points: mprog::model::train::read_curve(&val, 1),
+        },
+        mprog::render::Series {
+            name: "base alone".into(),
+            points: mprog::model::train::read_curve(&val, 2),
+        },
+    ];
+    mprog::render::plot_lines(
+        &out.join("hint.png"),
+        "hinted joints of x̂0: distance to their targets (validation)",
+        "step",
+        "mean distance (m)",
+        &series,
+        &mprog::render::PlotOptions::default(),
+    )
+    .map_err(|e| e.to_string())
 }
 
 fn read_config(path: &std::path::Path) -> Result<ControlTrainConfig> {

@@ -150,6 +150,9 @@ pub struct ControlTrainRun<'a> {
     pub interrupt: Interrupt,
     /// Device (without autodiff; the run adds it).
     pub device: Device,
+    /// Called with `out` after each checkpoint's `val.csv` row (e.g. to plot it); an error
+    /// is printed as a warning, never stops training.
+    pub after_checkpoint: Option<super::CheckpointHook>,
 }
 
 struct ControlState {
@@ -241,6 +244,11 @@ impl ControlTrainRun<'_> {
                 )?;
                 pending.clear();
                 self.log_validation(&base, &ck, &text, &schedule, (&mean, &std))?;
+                if let Some(hook) = self.after_checkpoint
+                    && let Err(e) = hook(&self.out)
+                {
+                    eprintln!("warning: after the checkpoint: {e}");
+                }
                 self.save(&ck)?;
                 saved_at = ck.state.step;
                 clock = Instant::now();
@@ -546,6 +554,14 @@ mod tests {
             max_steps_now: Some(steps),
             interrupt: Default::default(),
             device: Device::flex(),
+            after_checkpoint: Some(|out: &Path| {
+                // Each checkpoint's hook sees its val.csv row.
+                let rows =
+                    std::fs::read_to_string(out.join("val.csv")).map_err(|e| e.to_string())?;
+                let mut seen = std::fs::read_to_string(out.join("hooked")).unwrap_or_default();
+                seen.push_str(&format!("{}\n", rows.lines().count() - 1));
+                std::fs::write(out.join("hooked"), seen).map_err(|e| e.to_string())
+            }),
         };
         assert_eq!(run(6).run(&|_, _, _| {}).unwrap().step, 6);
         assert_eq!(run(4).run(&|_, _, _| {}).unwrap().step, 10, "resumed");
@@ -625,6 +641,7 @@ mod tests {
             max_steps_now: Some(1),
             interrupt: Default::default(),
             device: dev.clone(),
+            after_checkpoint: None,
         };
         let text = match &bundle.text {
             PromptEncoder::Words(v) => TrainText::Words(v.clone()),
@@ -654,6 +671,7 @@ mod tests {
             max_steps_now: Some(1),
             interrupt: Default::default(),
             device: Device::flex(),
+            after_checkpoint: None,
         }
         .run(&|_, _, _| {})
         .unwrap_err();
