@@ -1,6 +1,6 @@
 //! What the motion prior does with named actions (issue 28's "done when"): each prompt is
-//! generated with seeds 1 and 2 (DDIM 50, guidance 2.5 unless told, no cleanup) and one number is read
-//! off the motion against a threshold. `mprog bench actions` prints the table.
+//! generated with seeds 1 and 2 (DDIM 50, guidance 2.5 unless told, no cleanup) and one
+//! number is read off the motion against a threshold. `mprog bench actions` prints the table.
 //!
 //! Each prompt is as long as `mprog gen` makes it by default: the model's length prior
 //! ([`crate::model::lengths`]; 6 s for a model without one), except the walk, which the

@@ -15,8 +15,14 @@
 //! The first step has no hint (nothing is known yet); each later step uses the hint of the
 //! step before. A step whose hint controls nothing (the first, or every statement met) is
 //! not steered at all: the ControlNet was trained with at least one hinted frame, and an
-//! empty hint is a question it never saw. A keyframe program's hint is its keyframes: its joints, on its frames, at
-//! the places the inner loop put them (the targets, once it has met them).
+//! empty hint is a question it never saw. A keyframe program's hint is its keyframes: its
+//! joints, on its frames, at the places the inner loop put them (the targets, once it has
+//! met them).
+//!
+//! Cost ([`Realism::new`]): one ControlNet pass can steer both halves of the
+//! classifier-free-guidance batch, and a pass's additions can be reused on the next
+//! steps; `guide` and `lbfgs` do both by default (knobs `realism_shared`,
+//! `realism_every`).
 
 use super::SolveError;
 use super::driver::{Ctx, host};

@@ -30,7 +30,7 @@ use crate::interrupt::Interrupt;
 use crate::model::batch::{HostBatch, draw_batch, step_rng};
 use crate::model::config::TrainConfig;
 use crate::model::control::{CONTROL_FILE, ControlNet, Controlled, Hint};
-use crate::model::denoiser::{Denoiser, Mdm};
+use crate::model::denoiser::{Denoiser, DenoiserInput, Mdm};
 use crate::model::prompt::PromptEncoder;
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::model::weights::{ModelBundle, model_from_safetensors};
@@ -203,11 +203,9 @@ impl ControlTrainRun<'_> {
         while ck.state.step < stop_at && !self.interrupt.is_requested() {
             let step = ck.state.step;
             let batch = draw_batch(self.data, &train, &batches, step);
-            let (mut input, x0, valid) = to_device(&batch, &text, &device);
-            let joints = recover_from_ric_tensor(x0.clone() * std.clone() + mean.clone());
             let mut rng = step_rng(cfg.seed ^ 0xC0_17_20_1E, step);
-            let hint = training_hint(joints, &valid_lengths(&batch), &mut rng);
-            input.x_t = q_sample(&schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
+            let (input, x0, valid, hint) =
+                hinted_question(&batch, &text, &schedule, (&mean, &std), &mut rng);
             let pred = Controlled {
                 base: &base,
                 control: &ck.control,
@@ -284,7 +282,6 @@ impl ControlTrainRun<'_> {
         let mut cfg = self.config.batches();
         cfg.cond_drop = 0.0;
         cfg.word_drop = 0.0;
-        let device = mean.device();
         // Evaluation mode: no dropout in either network.
         let (base, control) = (&base.clone().freeze(), &control.clone().freeze());
         let (mut steered, mut alone) = (0.0, 0.0);
@@ -292,11 +289,9 @@ impl ControlTrainRun<'_> {
         for r in 0..rounds {
             // Fixed "steps" far beyond any real step keep the crops, noise and hints fixed.
             let batch = draw_batch(self.data, &clips, &cfg, usize::MAX - r);
-            let (mut input, x0, _) = to_device(&batch, text, &device);
-            let joints = recover_from_ric_tensor(x0.clone() * std.clone() + mean.clone());
             let mut rng = step_rng(cfg.seed ^ 0x7A_11D, r);
-            let hint = training_hint(joints, &valid_lengths(&batch), &mut rng);
-            input.x_t = q_sample(schedule, x0, &batch.timesteps, batch.noise_seed);
+            let (input, _, _, hint) =
+                hinted_question(&batch, text, schedule, (mean, std), &mut rng);
             let error = |pred: Tensor<3>| {
                 let joints = recover_from_ric_tensor(pred * std.clone() + mean.clone());
                 hint_distance(joints, &hint)
@@ -418,6 +413,22 @@ impl ControlTrainRun<'_> {
             .save(&bundle, true)
             .map_err(|e| file_err(&bundle, e))
     }
+}
+
+/// A batch as the ControlNet is asked it: the noised input, the clean motion, the valid
+/// mask, and a training hint from the clean joints.
+fn hinted_question(
+    batch: &HostBatch,
+    text: &TrainText,
+    schedule: &NoiseSchedule,
+    (mean, std): (&Tensor<3>, &Tensor<3>),
+    rng: &mut impl Rng,
+) -> (DenoiserInput, Tensor<3>, Tensor<3>, Hint) {
+    let (mut input, x0, valid) = to_device(batch, text, &mean.device());
+    let joints = recover_from_ric_tensor(x0.clone() * std.clone() + mean.clone());
+    let hint = training_hint(joints, &valid_lengths(batch), rng);
+    input.x_t = q_sample(schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
+    (input, x0, valid, hint)
 }
 
 /// Valid (not padding) frames of each clip of a batch.
