@@ -295,6 +295,25 @@ mod tests {
         )
     }
 
+    /// A small random denoiser and a ControlNet for it with random (non-zero) weights.
+    fn steering(seed: u64, dev: &Device) -> (Mdm, ControlNet) {
+        let base = Mdm::new(&config(32), vocab().len(), dev).valid();
+        let control = ControlNet::from_base(&base, dev).map(&mut Randomise(NoiseSource::new(seed)));
+        (base, control)
+    }
+
+    /// `input` stacked twice, as classifier-free guidance asks: `keep` says which rows read
+    /// their text.
+    fn guidance_pair(input: &DenoiserInput, keep: [f32; 4], dev: &Device) -> DenoiserInput {
+        DenoiserInput {
+            x_t: Tensor::cat(vec![input.x_t.clone(); 2], 0),
+            timesteps: vec![400; 4],
+            text: input.text.doubled(),
+            keep_text: Tensor::from_floats(keep, dev),
+            padding: None,
+        }
+    }
+
     fn max_diff(a: Tensor<3>, b: Tensor<3>) -> f32 {
         (a - b).abs().max().into_scalar::<f32>()
     }
@@ -316,13 +335,7 @@ mod tests {
             0.0
         );
         // A batch doubled for classifier-free guidance repeats the hint.
-        let doubled = DenoiserInput {
-            x_t: Tensor::cat(vec![input.x_t.clone(); 2], 0),
-            timesteps: vec![400; 4],
-            text: input.text.doubled(),
-            keep_text: Tensor::ones([4], &dev),
-            padding: None,
-        };
+        let doubled = guidance_pair(&input, [1.0; 4], &dev);
         assert_eq!(steered.predict_x0(&doubled).dims(), [4, 6, 263]);
     }
 
@@ -351,17 +364,10 @@ mod tests {
     #[test]
     fn a_shared_control_steers_both_guidance_halves_with_the_conditioned_pass() {
         let dev = Device::flex();
-        let base = Mdm::new(&config(32), vocab().len(), &dev).valid();
-        let control = ControlNet::from_base(&base, &dev).map(&mut Randomise(NoiseSource::new(3)));
+        let (base, control) = steering(3, &dev);
         let input = question(2, 6, &dev);
         // A guidance pair: the samples with their text, then without.
-        let pair = DenoiserInput {
-            x_t: Tensor::cat(vec![input.x_t.clone(); 2], 0),
-            timesteps: vec![400; 4],
-            text: input.text.doubled(),
-            keep_text: Tensor::from_floats([1.0, 1.0, 0.0, 0.0], &dev),
-            padding: None,
-        };
+        let pair = guidance_pair(&input, [1.0, 1.0, 0.0, 0.0], &dev);
         let run = |shared_guidance| {
             Controlled {
                 base: &base,
@@ -384,10 +390,6 @@ mod tests {
             hint(2, 6, &dev).values,
             None,
         );
-        let mut x = embedded.0.narrow(0, 2, 2);
-        for (layer, add) in base.encoder().layers.iter().zip(controls) {
-            x = layer.forward(x, None, None) + add;
-        }
         let uncond = DenoiserInput {
             x_t: input.x_t.clone(),
             timesteps: vec![400; 2],
@@ -395,14 +397,14 @@ mod tests {
             keep_text: Tensor::zeros([2], &dev),
             padding: None,
         };
-        assert!(max_diff(base.output(x, &uncond), half(shared, 1)) < 1e-5);
+        let x0 = with_controls(&base, embedded.0.narrow(0, 2, 2), None, &controls, &uncond);
+        assert!(max_diff(x0, half(shared, 1)) < 1e-5);
     }
 
     #[test]
     fn reused_controls_give_the_steered_prediction_without_the_control_net() {
         let dev = Device::flex();
-        let base = Mdm::new(&config(32), vocab().len(), &dev).valid();
-        let control = ControlNet::from_base(&base, &dev).map(&mut Randomise(NoiseSource::new(5)));
+        let (base, control) = steering(5, &dev);
         let input = question(2, 6, &dev);
         let steered = Controlled {
             base: &base,

@@ -275,15 +275,29 @@ mod tests {
         cfg: GuideConfig,
         control: Option<&ControlNet>,
     ) -> crate::solve::SolveResult {
+        guided_on(&keyframes, bundle, cfg, control)
+    }
+
+    /// `error` solved with `cfg`, steered by `control` when given.
+    fn guided_on(
+        error: &dyn MotionError,
+        bundle: &crate::model::ModelBundle,
+        cfg: GuideConfig,
+        control: Option<&ControlNet>,
+    ) -> crate::solve::SolveResult {
         let req = SolveRequest::new(
             vec!["a person walks forward".into()],
             FRAMES,
             3,
             Solver::new(cfg),
         );
-        let error: &dyn MotionError = &keyframes;
         let prior = Prior::from_bundle(bundle).with_control(control);
         solve(&prior, &req, error, &Device::flex(), |_| {}).unwrap()
+    }
+
+    /// A ControlNet for the tiny bundle with random (non-zero) weights, so it steers.
+    fn random_control(bundle: &crate::model::ModelBundle) -> ControlNet {
+        ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex())
     }
 
     #[test]
@@ -301,8 +315,7 @@ mod tests {
     #[test]
     fn a_met_program_gives_no_hint_and_is_not_steered() {
         let bundle = tiny_bundle();
-        let control =
-            ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
+        let control = random_control(&bundle);
         // Every ankle above −100 m: met everywhere, so its gradient is zero.
         let met = |j: Tensor<5>| {
             let [b, _, _, _, _] = j.dims();
@@ -310,18 +323,11 @@ mod tests {
             (ankle.neg() - 100.0).clamp_min(0.0).sum_dim(2).reshape([b])
         };
         let solve_with = |realism| {
-            let req = SolveRequest::new(
-                vec!["a person walks forward".into()],
-                FRAMES,
-                3,
-                Solver::new(GuideConfig {
-                    realism,
-                    ..short_guide()
-                }),
-            );
-            let error: &dyn MotionError = &met;
-            let prior = Prior::from_bundle(&bundle).with_control(Some(&control));
-            solve(&prior, &req, error, &Device::flex(), |_| {}).unwrap()
+            let cfg = GuideConfig {
+                realism,
+                ..short_guide()
+            };
+            guided_on(&met, &bundle, cfg, Some(&control))
         };
         assert_eq!(solve_with(true).features, solve_with(false).features);
     }
@@ -329,8 +335,7 @@ mod tests {
     #[test]
     fn a_shared_pass_steers_differently_from_a_pass_per_half() {
         let bundle = tiny_bundle();
-        let control =
-            ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
+        let control = random_control(&bundle);
         let go = |realism_shared| {
             guided(
                 &bundle,
@@ -350,8 +355,7 @@ mod tests {
     #[test]
     fn reusing_the_control_nets_additions_between_passes_changes_the_steering_a_little() {
         let bundle = tiny_bundle();
-        let control =
-            ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
+        let control = random_control(&bundle);
         let go = |realism_every| {
             guided(
                 &bundle,
@@ -389,8 +393,7 @@ mod tests {
     #[test]
     fn realism_share_steers_only_the_first_steps() {
         let bundle = tiny_bundle();
-        let control =
-            ControlNet::from_base(&bundle.model, &Device::flex()).randomised(&Device::flex());
+        let control = random_control(&bundle);
         let base = short_guide();
         let go = |cfg: GuideConfig| guided(&bundle, cfg, Some(&control));
         let off = go(GuideConfig {
