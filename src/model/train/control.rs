@@ -2,7 +2,9 @@
 //! base's training does, takes the hint from the clean motions themselves (one random joint
 //! of pelvis, feet, head and wrists per sample, on a random number of its frames, as
 //! OmniControl's `random_mask_train`), noises the motions and fits the controlled
-//! prediction to the clean motion with the masked x0 MSE. Only the ControlNet learns.
+//! prediction to the clean motion with the masked x0 MSE, plus the base's geometric terms
+//! (foot contact, velocity, bones) where the config weighs them. Only the ControlNet
+//! learns.
 //!
 //! ```text
 //! <out>/config.toml           ControlTrainConfig (fixed at the first start)
@@ -20,7 +22,7 @@
 
 use super::checkpoint::swap_in;
 use super::log::append;
-use super::losses::{masked_mse, q_sample, to_device};
+use super::losses::{GeometricLosses, prediction_loss, q_sample, to_device};
 use super::text::TrainText;
 use super::{TrainError, TrainState, file_err};
 use crate::dataset::{ClipInfo, Dataset, Split};
@@ -71,6 +73,17 @@ pub struct ControlTrainConfig {
     pub checkpoint_every: usize,
     /// Seed of the data order, hints and noise.
     pub seed: u64,
+    /// Weight of MDM's foot-contact term on the steered prediction (as the base's
+    /// `foot_loss`; 0: the x0 MSE alone, as OmniControl). The MSE barely sees a foot
+    /// that slides a few centimetres; this term does.
+    #[serde(default)]
+    pub foot_loss: f64,
+    /// Weight of MDM's velocity term on the steered prediction (as the base's).
+    #[serde(default)]
+    pub velocity_loss: f64,
+    /// Weight of the bone-length term on the steered prediction (as the base's).
+    #[serde(default)]
+    pub bone_loss: f64,
 }
 
 impl Default for ControlTrainConfig {
@@ -85,6 +98,9 @@ impl Default for ControlTrainConfig {
             steps: 100_000,
             checkpoint_every: 100,
             seed: 11,
+            foot_loss: 0.0,
+            velocity_loss: 0.0,
+            bone_loss: 0.0,
         }
     }
 }
@@ -97,6 +113,9 @@ impl ControlTrainConfig {
             crop_frames: self.crop_frames,
             cond_drop: self.cond_drop,
             seed: self.seed,
+            foot_loss: self.foot_loss,
+            velocity_loss: self.velocity_loss,
+            bone_loss: self.bone_loss,
             ..TrainConfig::default()
         }
     }
@@ -197,6 +216,7 @@ impl ControlTrainRun<'_> {
             .max_steps_now
             .map_or(cfg.steps, |n| (ck.state.step + n).min(cfg.steps));
         let (mean, std) = (stat(&bundle.mean, &device), stat(&bundle.std, &device));
+        let geometric = GeometricLosses::new(&batches, &self.data.mean, &self.data.std, &device);
         let (mut pending, mut sum, mut count) = (String::new(), 0.0f64, 0usize);
         let mut clock = Instant::now();
         let mut saved_at = ck.state.step;
@@ -213,7 +233,7 @@ impl ControlTrainRun<'_> {
                 shared_guidance: false,
             }
             .predict_x0(&input);
-            let loss = masked_mse(pred, x0, valid);
+            let loss = prediction_loss(pred, x0, valid, &batch.timesteps, &schedule, &geometric);
             let value = loss.clone().into_scalar::<f32>();
             if !value.is_finite() {
                 return Err(TrainError::Diverged { step, loss: value });
@@ -559,6 +579,9 @@ mod tests {
                 warmup_steps: 1,
                 checkpoint_every: 4,
                 steps: 100,
+                foot_loss: 0.01,
+                velocity_loss: 0.01,
+                bone_loss: 0.01,
                 ..ControlTrainConfig::default()
             },
             out: out.path().to_path_buf(),
@@ -613,6 +636,36 @@ mod tests {
         let fresh = ControlNet::from_base(&bundle.model, &dev);
         let bytes = |c: &ControlNet| crate::model::weights::module_to_safetensors(c, true).unwrap();
         assert_ne!(bytes(&control), bytes(&fresh));
+    }
+
+    #[test]
+    fn a_config_without_the_geometric_terms_reads_as_the_mse_alone() {
+        // Run folders written before the terms existed resume unchanged.
+        let old = "batch_size = 32\ncrop_frames = 120\nlearning_rate = 0.0001\nwarmup_steps = 200\n\
+                   grad_clip = 1.0\ncond_drop = 0.1\nsteps = 100000\ncheckpoint_every = 100\nseed = 11\n";
+        let cfg: ControlTrainConfig = toml::from_str(old).unwrap();
+        assert_eq!(cfg, ControlTrainConfig::default());
+        let g = GeometricLosses::new(&cfg.batches(), &[0.0; 263], &[1.0; 263], &Device::flex());
+        assert!(g.foot.is_none() && g.velocity.is_none() && g.bones.is_none());
+        let weighed = ControlTrainConfig {
+            foot_loss: 0.01,
+            bone_loss: 0.02,
+            ..cfg
+        };
+        let g = GeometricLosses::new(
+            &weighed.batches(),
+            &[0.0; 263],
+            &[1.0; 263],
+            &Device::flex(),
+        );
+        assert_eq!(g.foot.map(|f| f.weight), Some(0.01));
+        assert!(g.velocity.is_none());
+        assert_eq!(g.bones.map(|b| b.weight), Some(0.02));
+        let bad = ControlTrainConfig {
+            foot_loss: -1.0,
+            ..ControlTrainConfig::default()
+        };
+        assert!(bad.check().is_err(), "a negative weight is refused");
     }
 
     #[test]

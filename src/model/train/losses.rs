@@ -334,14 +334,27 @@ pub(super) fn batch_loss(
     let (mut input, x0, valid) = to_device(batch, text, device);
     input.x_t = q_sample(schedule, x0.clone(), &batch.timesteps, batch.noise_seed);
     let pred = model.predict_x0(&input);
+    prediction_loss(pred, x0, valid, &batch.timesteps, schedule, geometric)
+}
+
+/// The loss of a prediction of clean motions noised at `timesteps`: the x0 MSE plus the
+/// geometric terms that are on (the base's training and the ControlNet's share it).
+pub(super) fn prediction_loss(
+    pred: Tensor<3>,
+    x0: Tensor<3>,
+    valid: Tensor<3>,
+    timesteps: &[usize],
+    schedule: &NoiseSchedule,
+    geometric: &GeometricLosses,
+) -> Tensor<1> {
+    let device = &pred.device();
     // A clip weighed by w: its error scaled by √w, (√w·e)² = w·e².
     let weighted = match geometric.low_noise {
         Some((t0, cap)) => {
-            let root_w: Vec<f32> =
-                low_noise_weights(&schedule.alphas_cumprod, &batch.timesteps, t0, cap)
-                    .iter()
-                    .map(|w| w.sqrt())
-                    .collect();
+            let root_w: Vec<f32> = low_noise_weights(&schedule.alphas_cumprod, timesteps, t0, cap)
+                .iter()
+                .map(|w| w.sqrt())
+                .collect();
             let b = root_w.len();
             let root_w: Tensor<3> = Tensor::from_data(TensorData::new(root_w, [b, 1, 1]), device);
             x0.clone() + (pred.clone() - x0.clone()) * root_w
@@ -365,8 +378,7 @@ pub(super) fn batch_loss(
     }
     if let Some(l) = &geometric.bones {
         let term = if geometric.bones_by_signal {
-            let signal: Vec<f32> = batch
-                .timesteps
+            let signal: Vec<f32> = timesteps
                 .iter()
                 .map(|&t| schedule.alphas_cumprod[t] as f32)
                 .collect();
