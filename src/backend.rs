@@ -91,6 +91,35 @@ pub fn machine_description() -> String {
     }
 }
 
+/// Stack of the compute pool's threads: the main thread's usual 8 MiB, since the whole
+/// command runs on one of them (parsing an untrusted program recurses).
+const POOL_STACK_BYTES: usize = 8 << 20;
+
+/// Runs `f` on a thread of rayon's global pool, the pool burn-flex splits its large
+/// element-wise ops, reductions and matrix products across.
+///
+/// Called from outside the pool, every such op hands its pieces to the pool's threads and
+/// puts the caller to sleep on a futex until they are done: two context switches per op,
+/// and the caller's own core idle meanwhile. A program's error + gradient at batch 32 is
+/// ~60 such ops of 140K elements, and `perf` put a quarter of its samples in that hand-off
+/// (`LockLatch::wait_and_reset`, `sched_yield`, `try_to_wake_up`). Run from a pool thread,
+/// an op forks in place and the calling thread works one of the pieces itself (HSI-3's
+/// gradient at batch 32: 2.5–2.6 ms → 1.4 ms; book, benchmarks page).
+///
+/// `MPROG_COMPUTE_ON_POOL=0` runs `f` on the calling thread instead (to measure the
+/// difference). The pool is built here with [`POOL_STACK_BYTES`] stacks unless something
+/// built it already.
+pub fn on_compute_pool<T: Send>(f: impl FnOnce() -> T + Send) -> T {
+    if std::env::var("MPROG_COMPUTE_ON_POOL").is_ok_and(|v| v.trim() == "0") {
+        return f();
+    }
+    // An error means the global pool exists already; it is used as it is.
+    let _ = rayon::ThreadPoolBuilder::new()
+        .stack_size(POOL_STACK_BYTES)
+        .build_global();
+    rayon::scope(|_| f())
+}
+
 /// glibc hands every freed block above 128 KiB back to the kernel, so each training step,
 /// sampling step or solver iteration faults its activations in again as fresh zeroed pages:
 /// 52,000 page faults a second and a third of the CPU in the kernel while training (measured

@@ -59,6 +59,10 @@ enum Command {
 fn main() -> miette::Result<()> {
     mprog::backend::tune_allocator();
     let cli = Cli::parse();
+    mprog::backend::on_compute_pool(|| run(cli))
+}
+
+fn run(cli: Cli) -> miette::Result<()> {
     match cli.command {
         Command::Joints => print_joints(),
         Command::Gen(args) => cli::generate::run(args)?,

@@ -22,7 +22,9 @@ pub fn unary(op: UnaryOp, x: Tensor<4>) -> Tensor<4> {
         UnaryOp::Neg => x.neg(),
         UnaryOp::Abs => x.abs(),
         UnaryOp::Sqrt => x.clamp_min(0.0).add_scalar(1e-12).sqrt(),
-        UnaryOp::Relu => x.clamp_min(0.0),
+        // burn's relu, not clamp_min(0): its backward is one pass over the output, where
+        // clamp_min's builds a comparison mask and then fills with it (two).
+        UnaryOp::Relu => burn::tensor::activation::relu(x),
         UnaryOp::Sin => x.sin(),
         UnaryOp::Cos => x.cos(),
         UnaryOp::Square => x.square(),
@@ -38,8 +40,8 @@ pub fn binary(op: BinaryOp, a: Tensor<4>, b: Tensor<4>) -> Tensor<4> {
         BinaryOp::Mul => a * b,
         BinaryOp::Div => a / b,
         // min(a, b) = a − max(a − b, 0); max(a, b) = a + max(b − a, 0): broadcasting ops only.
-        BinaryOp::Min => a.clone() - (a - b).clamp_min(0.0),
-        BinaryOp::Max => a.clone() + (b - a).clamp_min(0.0),
+        BinaryOp::Min => a.clone() - burn::tensor::activation::relu(a - b),
+        BinaryOp::Max => a.clone() + burn::tensor::activation::relu(b - a),
         BinaryOp::Atan2 => {
             let c = a.dims()[3].max(b.dims()[3]);
             let shape = common_shape(&[&a, &b], c);
