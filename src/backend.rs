@@ -107,7 +107,7 @@ const POOL_STACK_BYTES: usize = 8 << 20;
 /// gradient at batch 32: 2.5–2.6 ms → 1.4 ms; book, benchmarks page).
 ///
 /// `MPROG_COMPUTE_ON_POOL=0` runs `f` on the calling thread instead (to measure the
-/// difference). The pool is built here with [`POOL_STACK_BYTES`] stacks unless something
+/// difference). The pool is built here with 8 MiB stacks unless something
 /// built it already.
 pub fn on_compute_pool<T: Send>(f: impl FnOnce() -> T + Send) -> T {
     if std::env::var("MPROG_COMPUTE_ON_POOL").is_ok_and(|v| v.trim() == "0") {

@@ -358,6 +358,24 @@ fn statement_error(
         return Tensor::<2>::zeros([batch, 1], device);
     }
     let err = values[s.error].clone().expect("statement error is kept");
+    if s.mask.is_none() {
+        // Mean over frames summed over lanes is one sum over the contiguous frames × lanes
+        // of each sample, then a scale: a single pass, where `mean_dim(1)` reads
+        // frame-strided.
+        let [b, f, lanes, c] = err.dims();
+        let factor = s.weight * (s.lanes / lanes.max(1)) as f64 / f as f64;
+        let col = err.reshape([b, f * lanes * c]).sum_dim(1);
+        let col = if factor == 1.0 {
+            col
+        } else {
+            col.mul_scalar(factor)
+        };
+        return if b == batch {
+            col
+        } else {
+            col.expand([batch, 1])
+        };
+    }
     let (reduced, lanes) = match s.mask.and_then(|m| values[m].clone()) {
         Some(mask) => {
             let lanes = err.dims()[2].max(mask.dims()[2]);
