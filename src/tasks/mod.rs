@@ -56,8 +56,21 @@ pub struct RunRow {
     pub failure: Option<String>,
     /// `[frames, 263]` de-normalised features of every motion, for the realism score.
     pub features: Vec<Vec<f32>>,
-    /// Keyframe tasks: each cell's (joint, density label) and keyframe distances.
-    pub cells: Vec<(usize, String, Vec<f32>)>,
+    /// Keyframe tasks: what each cell's sample did.
+    pub cells: Vec<CellOutcome>,
+}
+
+/// One keyframe cell's sample, measured.
+#[derive(Clone, Debug)]
+pub struct CellOutcome {
+    /// The controlled joint.
+    pub joint: usize,
+    /// The density's label.
+    pub density: String,
+    /// Distance at each keyframe (m).
+    pub distances: Vec<f32>,
+    /// The sample's foot-skating ratio.
+    pub skating: f32,
 }
 
 /// One solve of `task` with `solver`, measured.
@@ -142,7 +155,13 @@ pub fn run_task(
                 .cells
                 .iter()
                 .zip(distances)
-                .map(|(cell, d)| (cell.joint, cell.density.label(), d))
+                .zip(&firsts)
+                .map(|((cell, distances), motion)| CellOutcome {
+                    joint: cell.joint,
+                    density: cell.density.label(),
+                    distances,
+                    skating: foot_skating_ratio(motion),
+                })
                 .collect();
         }
     }

@@ -200,14 +200,23 @@ fn keyframe_details(md: &mut String, rows: &[&RunRow]) {
     // (joint or density label) → solver → distances.
     let mut by_joint: BTreeMap<usize, BTreeMap<String, Vec<f32>>> = BTreeMap::new();
     let mut by_density: Vec<(String, BTreeMap<String, Vec<f32>>)> = Vec::new();
+    // joint → solver → each sample's foot-skating ratio.
+    let mut skating: BTreeMap<usize, BTreeMap<String, Vec<f32>>> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.failure.is_none()) {
-        for (joint, density, d) in &r.cells {
+        for cell in &r.cells {
+            let (joint, density, d) = (&cell.joint, &cell.density, &cell.distances);
             by_joint
                 .entry(*joint)
                 .or_default()
                 .entry(r.solver.clone())
                 .or_default()
                 .extend(d);
+            skating
+                .entry(*joint)
+                .or_default()
+                .entry(r.solver.clone())
+                .or_default()
+                .push(cell.skating);
             let slot = match by_density.iter().position(|(l, _)| l == density) {
                 Some(i) => i,
                 None => {
@@ -232,18 +241,28 @@ fn keyframe_details(md: &mut String, rows: &[&RunRow]) {
         solvers.join(" | "),
         " --- |".repeat(solvers.len())
     );
-    let _ = writeln!(
+    let joint_rows =
+        |md: &mut String, title: &str, map: &BTreeMap<usize, BTreeMap<String, Vec<f32>>>| {
+            let _ = writeln!(md, "\n{title}:\n\n| joint {header}");
+            for (joint, per) in map {
+                let name = CONTROLLED
+                    .iter()
+                    .find(|c| c.0 == *joint)
+                    .map_or("?", |c| c.1);
+                let cells: Vec<String> = solvers.iter().map(|s| mean(per.get(s))).collect();
+                let _ = writeln!(md, "| {name} | {} |", cells.join(" | "));
+            }
+        };
+    joint_rows(
         md,
-        "\nAverage keyframe error (m) by controlled joint:\n\n| joint {header}"
+        "Average keyframe error (m) by controlled joint",
+        &by_joint,
     );
-    for (joint, per) in &by_joint {
-        let name = CONTROLLED
-            .iter()
-            .find(|c| c.0 == *joint)
-            .map_or("?", |c| c.1);
-        let cells: Vec<String> = solvers.iter().map(|s| mean(per.get(s))).collect();
-        let _ = writeln!(md, "| {name} | {} |", cells.join(" | "));
-    }
+    joint_rows(
+        md,
+        "Foot skating by controlled joint (PMG's ratio, mean over the samples that control it)",
+        &skating,
+    );
     let _ = writeln!(
         md,
         "\nAverage keyframe error (m) by density:\n\n| density {header}"
@@ -251,5 +270,60 @@ fn keyframe_details(md: &mut String, rows: &[&RunRow]) {
     for (label, per) in &by_density {
         let cells: Vec<String> = solvers.iter().map(|s| mean(per.get(s))).collect();
         let _ = writeln!(md, "| {label} | {} |", cells.join(" | "));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tasks::CellOutcome;
+
+    fn row(solver: &str, cells: Vec<CellOutcome>) -> RunRow {
+        RunRow {
+            family: Family::Keyframe,
+            task: "clip".into(),
+            solver: solver.into(),
+            motions: cells.len(),
+            error: 0.0,
+            unsuccess: 0.0,
+            control: None,
+            skating: 0.0,
+            max_accel: 0.0,
+            bone_error: 0.0,
+            seconds_per_sample: 1.0,
+            failure: None,
+            features: Vec::new(),
+            cells,
+        }
+    }
+
+    fn cell(joint: usize, distance: f32, skating: f32) -> CellOutcome {
+        CellOutcome {
+            joint,
+            density: "1 frame".into(),
+            distances: vec![distance],
+            skating,
+        }
+    }
+
+    #[test]
+    fn keyframe_details_give_each_controlled_joints_error_and_skating_per_solver() {
+        let (pelvis, left_foot) = (CONTROLLED[0].0, CONTROLLED[1].0);
+        let a = row(
+            "guide",
+            vec![cell(pelvis, 0.01, 0.1), cell(pelvis, 0.03, 0.3), cell(left_foot, 0.02, 0.5)],
+        );
+        let b = row("plain", vec![cell(pelvis, 0.4, 0.0)]);
+        let mut md = String::new();
+        keyframe_details(&mut md, &[&a, &b]);
+        let table = |title: &str| {
+            let at = md.find(title).unwrap_or_else(|| panic!("no {title} in\n{md}"));
+            md[at..].lines().skip(4).take(2).collect::<Vec<_>>().join("\n")
+        };
+        let errors = table("Average keyframe error (m) by controlled joint");
+        let skating = table("Foot skating by controlled joint");
+        let (p, f) = (CONTROLLED[0].1, CONTROLLED[1].1);
+        assert_eq!(errors, format!("| {p} | 0.020 | 0.400 |\n| {f} | 0.020 | — |"));
+        assert_eq!(skating, format!("| {p} | 0.200 | 0.000 |\n| {f} | 0.500 | — |"));
     }
 }
