@@ -311,19 +311,36 @@ mod tests {
         let (pelvis, left_foot) = (CONTROLLED[0].0, CONTROLLED[1].0);
         let a = row(
             "guide",
-            vec![cell(pelvis, 0.01, 0.1), cell(pelvis, 0.03, 0.3), cell(left_foot, 0.02, 0.5)],
+            vec![
+                cell(pelvis, 0.01, 0.1),
+                cell(pelvis, 0.03, 0.3),
+                cell(left_foot, 0.02, 0.5),
+            ],
         );
         let b = row("plain", vec![cell(pelvis, 0.4, 0.0)]);
         let mut md = String::new();
         keyframe_details(&mut md, &[&a, &b]);
         let table = |title: &str| {
-            let at = md.find(title).unwrap_or_else(|| panic!("no {title} in\n{md}"));
-            md[at..].lines().skip(4).take(2).collect::<Vec<_>>().join("\n")
+            let at = md
+                .find(title)
+                .unwrap_or_else(|| panic!("no {title} in\n{md}"));
+            md[at..]
+                .lines()
+                .skip(4)
+                .take(2)
+                .collect::<Vec<_>>()
+                .join("\n")
         };
         let errors = table("Average keyframe error (m) by controlled joint");
         let skating = table("Foot skating by controlled joint");
         let (p, f) = (CONTROLLED[0].1, CONTROLLED[1].1);
-        assert_eq!(errors, format!("| {p} | 0.020 | 0.400 |\n| {f} | 0.020 | — |"));
-        assert_eq!(skating, format!("| {p} | 0.200 | 0.000 |\n| {f} | 0.500 | — |"));
+        assert_eq!(
+            errors,
+            format!("| {p} | 0.020 | 0.400 |\n| {f} | 0.020 | — |")
+        );
+        assert_eq!(
+            skating,
+            format!("| {p} | 0.200 | 0.000 |\n| {f} | 0.500 | — |")
+        );
     }
 }
