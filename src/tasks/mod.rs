@@ -60,6 +60,28 @@ pub struct RunRow {
     pub cells: Vec<CellOutcome>,
 }
 
+impl RunRow {
+    /// A row of (task, solver) with nothing measured yet: every number zero.
+    pub fn unmeasured(family: Family, task: &str, solver: &str) -> Self {
+        RunRow {
+            family,
+            task: task.to_string(),
+            solver: solver.to_string(),
+            motions: 0,
+            error: 0.0,
+            unsuccess: 0.0,
+            control: None,
+            skating: 0.0,
+            max_accel: 0.0,
+            bone_error: 0.0,
+            seconds_per_sample: 0.0,
+            failure: None,
+            features: Vec::new(),
+            cells: Vec::new(),
+        }
+    }
+}
+
 /// One keyframe cell's sample, measured.
 #[derive(Clone, Debug)]
 pub struct CellOutcome {
@@ -82,22 +104,7 @@ pub fn run_task(
     device: &Device,
     on_progress: &mut dyn FnMut(Progress),
 ) -> RunRow {
-    let mut row = RunRow {
-        family: task.family,
-        task: task.name.clone(),
-        solver: solver.name().to_string(),
-        motions: 0,
-        error: 0.0,
-        unsuccess: 0.0,
-        control: None,
-        skating: 0.0,
-        max_accel: 0.0,
-        bone_error: 0.0,
-        seconds_per_sample: 0.0,
-        failure: None,
-        features: Vec::new(),
-        cells: Vec::new(),
-    };
+    let mut row = RunRow::unmeasured(task.family, &task.name, solver.name());
     let req = SolveRequest {
         samples: task.samples,
         placements: task.placements(),

@@ -280,20 +280,9 @@ mod tests {
 
     fn row(solver: &str, cells: Vec<CellOutcome>) -> RunRow {
         RunRow {
-            family: Family::Keyframe,
-            task: "clip".into(),
-            solver: solver.into(),
             motions: cells.len(),
-            error: 0.0,
-            unsuccess: 0.0,
-            control: None,
-            skating: 0.0,
-            max_accel: 0.0,
-            bone_error: 0.0,
-            seconds_per_sample: 1.0,
-            failure: None,
-            features: Vec::new(),
             cells,
+            ..RunRow::unmeasured(Family::Keyframe, "clip", solver)
         }
     }
 
