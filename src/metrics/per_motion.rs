@@ -86,10 +86,42 @@ pub fn foot_skating_ratio(m: &Motion) -> f32 {
 
 /// Largest second difference of any joint position (m/frame², no fps scaling).
 pub fn max_acceleration(m: &Motion) -> f32 {
-    m.frames
-        .windows(3)
-        .flat_map(|w| (0..NUM_JOINTS).map(move |j| (w[2][j] - 2.0 * w[1][j] + w[0][j]).length()))
-        .fold(0.0, f32::max)
+    peak_acceleration(m).value
+}
+
+/// Where a motion's largest second difference is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PeakAcceleration {
+    /// Its length (m/frame²); 0 for a motion of fewer than 3 frames.
+    pub value: f32,
+    /// The joint.
+    pub joint: usize,
+    /// The middle frame of the three.
+    pub frame: usize,
+}
+
+/// The largest second difference of any joint position, with its joint and frame (the
+/// first one on ties).
+pub fn peak_acceleration(m: &Motion) -> PeakAcceleration {
+    let mut peak = PeakAcceleration {
+        value: 0.0,
+        joint: 0,
+        frame: 0,
+    };
+    for (i, w) in m.frames.windows(3).enumerate() {
+        let (before, at, after) = (&w[0], &w[1], &w[2]);
+        for j in 0..NUM_JOINTS {
+            let a = (after[j] - 2.0 * at[j] + before[j]).length();
+            if a > peak.value {
+                peak = PeakAcceleration {
+                    value: a,
+                    joint: j,
+                    frame: i + 1,
+                };
+            }
+        }
+    }
+    peak
 }
 
 /// Mean over the 21 bones of (std / mean) of the bone's length over time.
@@ -365,6 +397,8 @@ mod tests {
         // √(0.01 + 0.36 + 0.64) = √1.01.
         m.frames[2][20] += Vec3::new(0.0, 0.3, 0.4);
         approx(max_acceleration(&m), 1.01f32.sqrt(), 1e-5);
+        let peak = peak_acceleration(&m);
+        assert_eq!((peak.joint, peak.frame), (20, 2));
         assert_eq!(max_acceleration(&shifted(&[Vec3::ZERO; 2])), 0.0);
     }
 

@@ -87,7 +87,7 @@ pub fn clean_feet(
     }
     let motions = rows.len() / (frames * width);
     let mut head = extract_head(rows, width);
-    let mut projection = SkeletonProjection::new(&head);
+    let mut projection = SkeletonProjection::new(&head, frames);
     let mut fk = HostFk::default();
     let mut projected = vec![0.0; head.len()];
     let mut joints = vec![0.0; motions * frames * J3];

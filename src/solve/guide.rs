@@ -9,12 +9,15 @@
 //!                  μ ← μ − τ·Σ̂·g
 //! x_{t−1} ← μ + σ_t·ε   (no noise at the last step)
 //! ```
-//! mprog's additions, each on by default and turned back by its knob (why each was made,
+//! mprog's additions, each on by default (but the acceleration hold) and turned back by its
+//! knob (why each was made,
 //! with the renders and numbers behind it: the book's "Six places where `guide` departs
 //! from OmniControl"):
 //! * early steps move only the root columns ([`FusedSettings::early_root_only`], `early_root`);
 //! * the last T_s steps keep bone lengths and planted feet ([`FusedSettings::keep_skeleton`],
-//!   [`super::bones`]), hold planted toes ([`FusedSettings::foot_lock`], [`super::feet`]),
+//!   [`super::bones`]), hold planted toes ([`FusedSettings::foot_lock`], [`super::feet`])
+//!   and hold back the joint acceleration they add ([`FusedSettings::accel_hold`],
+//!   [`super::accel`]),
 //!   smooth the step over frames ([`GuideConfig::smooth_frames`]), give each statement its
 //!   own Polyak step ([`FusedSettings::split_terms`]) and scale the root columns down
 //!   ([`FusedSettings::late_root_scale`], `late_root`);
@@ -62,6 +65,13 @@ pub enum StepRule {
 /// Root columns of a feature row: yaw velocity, XZ velocity, height.
 pub(crate) const ROOT_COLUMNS: usize = 4;
 
+/// Default weight of the acceleration hold ([`FusedSettings::accel_hold`]): off. At 0.25
+/// it took the keyframe family's peak acceleration from 0.123 to 0.110 at the bench's fast
+/// settings (100 steps, 50 iterations in each of the last 5), but at the CLI's (1000
+/// steps, 500 iterations in each of the last 10) it bent HSI-2's walk under the barrier
+/// into a crouch with its facing spinning (book, solvers chapter).
+pub const ACCEL_HOLD: f32 = 0.0;
+
 /// Largest change of one normalised feature in one Polyak iteration.
 pub const MAX_POLYAK_DELTA: f32 = 0.5;
 
@@ -100,7 +110,9 @@ pub struct GuideConfig {
     /// Share of the chain's steps, from the first (noisiest) on, that the ControlNet
     /// steers (0–1; 1: every step, as OmniControl). The ControlNet is a second encoder
     /// pass per step: steering the early steps, where pose and path are decided, costs
-    /// that much less.
+    /// that much less. 0.5 by default: on the keyframe tasks the first half skated less
+    /// than every step did, at the same acceleration and FID (steps 8,500 and 9,700 of
+    /// the ControlNet's training; book, solvers chapter).
     pub realism_share: f32,
     /// The ControlNet runs once per step, on the text-conditioned half of classifier-free
     /// guidance, and steers both halves: half its cost. OmniControl runs it on each half;
@@ -124,6 +136,9 @@ pub struct FusedSettings {
     /// Weight of the slide penalty on planted feet in the last `late_steps` steps
     /// ([`super::feet`]); 0 turns it off.
     pub foot_lock: f32,
+    /// Weight of the penalty on the joint acceleration the last `late_steps` steps add
+    /// ([`super::accel`]); 0 turns it off.
+    pub accel_hold: f32,
     /// Before the last `late_steps` steps, step only the root columns (yaw velocity, XZ
     /// velocity, height): the path is steered while the denoiser keeps the pose its own
     /// (see the module notes).
@@ -145,12 +160,18 @@ impl FusedSettings {
     pub const PLAIN: FusedSettings = FusedSettings {
         keep_skeleton: false,
         foot_lock: 0.0,
+        accel_hold: 0.0,
         early_root_only: false,
         split_terms: false,
         late_root_scale: 1.0,
     };
 
     fn check_settings(&self) -> Result<(), SolveError> {
+        if !(self.accel_hold.is_finite() && self.accel_hold >= 0.0) {
+            return Err(SolveError::Invalid(
+                "guide: the acceleration hold's weight must be finite and ≥ 0".into(),
+            ));
+        }
         if !(self.foot_lock.is_finite() && self.foot_lock >= 0.0) {
             return Err(SolveError::Invalid(
                 "guide: the foot lock's weight must be finite and ≥ 0".into(),
@@ -170,6 +191,7 @@ impl Default for FusedSettings {
         FusedSettings {
             keep_skeleton: true,
             foot_lock: 1.0,
+            accel_hold: ACCEL_HOLD,
             early_root_only: true,
             split_terms: true,
             late_root_scale: 0.01,
@@ -192,7 +214,7 @@ impl Default for GuideConfig {
             smooth_frames: 4.0,
             fused: Some(FusedSettings::default()),
             realism: true,
-            realism_share: 1.0,
+            realism_share: 0.5,
             realism_shared: true,
             realism_every: 2,
         }
@@ -348,6 +370,8 @@ struct Inner {
     skeleton: bool,
     /// The foot lock's weight (0: without).
     foot_lock: f32,
+    /// The acceleration hold's weight (0: without).
+    accel_hold: f32,
     /// Columns of a head row that move: the root's, or all of them.
     moving: usize,
     /// A Polyak step per term.
@@ -366,6 +390,7 @@ impl Inner {
             step,
             skeleton: fused.keep_skeleton && late,
             foot_lock: if late { fused.foot_lock } else { 0.0 },
+            accel_hold: if late { fused.accel_hold } else { 0.0 },
             moving: if fused.early_root_only && !late {
                 ROOT_COLUMNS
             } else {
@@ -392,6 +417,7 @@ fn guide_fused(
         step,
         skeleton,
         foot_lock,
+        accel_hold,
         moving,
         split,
         root_scale,
@@ -408,6 +434,9 @@ fn guide_fused(
     }
     if foot_lock > 0.0 {
         objective.lock_feet(&head, foot_lock);
+    }
+    if accel_hold > 0.0 {
+        objective.hold_accel(&head, accel_hold);
     }
     let mut terms = TermGradients::default();
     let mut combined = vec![0.0; head.len()];
@@ -700,6 +729,7 @@ impl SolverConfig for GuideConfig {
         ),
         knob!(Real, "smooth", "σ in frames of the Gaussian each late step's gradient is smoothed with over time; 0: OmniControl's raw gradient", smooth_frames),
         fused_knob!(Real, "feet", "weight of the slide penalty on planted toes in the last `late_steps`; 0: off", foot_lock),
+        fused_knob!(Real, "accel", "weight of the penalty on the joint acceleration the last `late_steps` add (jerks where keyframes are scattered); 0: off", accel_hold),
         fused_knob!(
             Flag("every column", "root columns only before the late steps"),
             "early_root",

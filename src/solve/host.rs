@@ -15,6 +15,7 @@
 //! The backward runs these in reverse (reverse cumulative sums for the two prefix sums).
 //! Tests check forward and gradient against the burn graph ([`super::Decoder`]).
 
+use super::accel::AccelHold;
 use super::bones::SkeletonProjection;
 use super::decode::Decoder;
 use super::driver::host;
@@ -152,7 +153,9 @@ pub struct HostObjective<'a> {
     projection: Option<SkeletonProjection>,
     /// Slide penalty on planted feet ([`Self::lock_feet`]).
     feet: Option<FootLock>,
-    /// That penalty per sample at the last evaluation (zeros without it).
+    /// Penalty on added acceleration ([`Self::hold_accel`]).
+    accel: Option<AccelHold>,
+    /// The two penalties per sample at the last evaluation (zeros without them).
     penalty: Vec<f32>,
     /// Rigid XZ transform per motion `[B·P]`, applied in the person's frame before its
     /// placement (`latent`'s relaxation, [`Self::set_rigid`]).
@@ -187,6 +190,7 @@ impl<'a> HostObjective<'a> {
             joints: Vec::new(),
             projection: None,
             feet: None,
+            accel: None,
             penalty: vec![0.0; batch],
             rigid: None,
             local: Vec::new(),
@@ -218,22 +222,53 @@ impl<'a> HostObjective<'a> {
         planted
     }
 
-    /// Stop adding the foot penalty.
+    /// From now on add [`AccelHold`]'s penalty (weight `weight`) on the joint acceleration
+    /// added to these normalised heads (after the skeleton projection, if one is set up) to
+    /// what [`eval`](Self::eval) differentiates.
+    pub fn hold_accel(&mut self, head: &[f32], weight: f32) {
+        let people = self.placements.len();
+        let joints = self.world_joints(head).to_vec();
+        self.accel = Some(AccelHold::new(&joints, self.frames, people, weight));
+    }
+
+    /// Stop adding the foot and acceleration penalties.
     pub fn unlock_feet(&mut self) {
         self.feet = None;
+        self.accel = None;
         self.penalty.fill(0.0);
     }
 
-    /// The foot penalty per sample at the last [`eval`](Self::eval): its gradient is in
-    /// that evaluation's gradient, its value is not in the returned errors.
+    /// The foot and acceleration penalties per sample at the last [`eval`](Self::eval):
+    /// their gradient is in that evaluation's gradient, their value is not in the returned
+    /// errors.
     pub fn penalty(&self) -> &[f32] {
         &self.penalty
+    }
+
+    /// Whether a penalty is set.
+    fn penalized(&self) -> bool {
+        self.feet.is_some() || self.accel.is_some()
+    }
+
+    /// The penalties of the current joints per sample; their gradient added to `g`.
+    fn eval_penalties(&self, g: &mut [f32]) -> Vec<f32> {
+        let mut penalty = vec![0.0; self.batch];
+        for p in [
+            self.feet.as_ref().map(|lock| lock.eval(&self.joints, g)),
+            self.accel.as_ref().map(|hold| hold.eval(&self.joints, g)),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            penalty.iter_mut().zip(p).for_each(|(a, b)| *a += b);
+        }
+        penalty
     }
 
     /// From now on evaluate the error of `P(head)`, the skeleton projection set up on these
     /// normalised heads (see [`super::bones`]); returns how many frames have a planted foot.
     pub fn project_skeleton(&mut self, head: &[f32]) -> usize {
-        let map = SkeletonProjection::new(&self.denormalize(head));
+        let map = SkeletonProjection::new(&self.denormalize(head), self.frames);
         let anchored = map.anchored();
         self.projection = Some(map);
         anchored
@@ -302,7 +337,8 @@ impl<'a> HostObjective<'a> {
     }
 
     /// Errors per sample `[B]`; writes `∂(Σ_b error_b + penalty_b)/∂head` (normalised) into
-    /// `grad`, where the penalty is the foot lock's, if set ([`Self::penalty`]). Values are
+    /// `grad`, where the penalty is the foot lock's and the acceleration hold's, if set
+    /// ([`Self::penalty`]). Values are
     /// returned as computed (the caller checks them for NaN/Inf).
     pub fn eval(&mut self, head: &[f32], grad: &mut [f32]) -> Result<Vec<f32>, SolveError> {
         let people = self.placements.len();
@@ -320,25 +356,25 @@ impl<'a> HostObjective<'a> {
         } else {
             None
         };
-        let mut g = match (g_world, &self.feet) {
+        let mut g = match (g_world, self.penalized()) {
             (Some(g), _) => g,
-            (None, Some(_)) => vec![0.0; self.joints.len()],
-            (None, None) => {
+            (None, true) => vec![0.0; self.joints.len()],
+            (None, false) => {
                 grad.fill(0.0);
                 self.g_rigid = vec![0.0; 3 * self.rigid.as_ref().map_or(0, Vec::len)];
                 return Ok(values);
             }
         };
-        if let Some(lock) = &self.feet {
-            self.penalty = lock.eval(&self.joints, &mut g);
+        if self.penalized() {
+            self.penalty = self.eval_penalties(&mut g);
         }
         self.g_rigid = self.to_head_gradient(&mut g, grad);
         Ok(values)
     }
 
     /// Errors per sample `[B]` and each term's value and gradient (normalised heads), into
-    /// `out`: the error's [`terms`](MotionError::terms), then the foot lock's penalty if
-    /// set. A term with no error in any sample gets no gradient pass (its gradient is left
+    /// `out`: the error's [`terms`](MotionError::terms), then the foot lock's and the
+    /// acceleration hold's penalty if set. A term with no error in any sample gets no gradient pass (its gradient is left
     /// zero), so satisfied hinges cost nothing.
     pub fn eval_terms(&mut self, head: &[f32], out: &mut TermGradients) -> Result<(), SolveError> {
         let people = self.placements.len();
@@ -360,7 +396,7 @@ impl<'a> HostObjective<'a> {
             .map(|row| row.iter().sum())
             .collect();
         out.statements = count;
-        let with_feet = count + usize::from(self.feet.is_some());
+        let with_feet = count + usize::from(self.penalized());
         out.values.resize(with_feet, Vec::new());
         out.grads.resize(with_feet, Vec::new());
         for (t, v) in out.values.iter_mut().take(count).enumerate() {
@@ -389,9 +425,9 @@ impl<'a> HostObjective<'a> {
             let mut g = g.into_data().try_to_vec::<f32>().expect("f32 gradient");
             self.to_head_gradient(&mut g, grad);
         }
-        if let Some(lock) = &self.feet {
+        if self.penalized() {
             let mut g = vec![0.0; self.joints.len()];
-            self.penalty = lock.eval(&self.joints, &mut g);
+            self.penalty = self.eval_penalties(&mut g);
             out.values[count] = self.penalty.clone();
             let grad = &mut out.grads[count];
             grad.resize(head.len(), 0.0);

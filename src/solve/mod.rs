@@ -49,6 +49,7 @@
 //! # Ok(()) }
 //! ```
 
+pub mod accel;
 pub mod adam;
 pub mod bones;
 pub mod cleanup;

@@ -408,7 +408,10 @@ mod tests {
             realism_share: 0.5,
             ..base.clone()
         });
-        let all = go(base.clone());
+        let all = go(GuideConfig {
+            realism_share: 1.0,
+            ..base.clone()
+        });
         assert_eq!(off.features, none.features, "a share of 0 steers nothing");
         assert_ne!(off.features, half.features, "a random ControlNet steers");
         assert_ne!(

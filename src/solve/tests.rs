@@ -655,6 +655,7 @@ fn fused_and_graph_guidance_agree() {
         fused: Some(FusedSettings {
             keep_skeleton: false,
             foot_lock: 0.0,
+            accel_hold: 0.0,
             early_root_only: false,
             split_terms: false,
             ..FusedSettings::default()
@@ -1007,6 +1008,75 @@ fn early_steps_steer_the_root_and_leave_the_pose_to_the_denoiser() {
         steered.error[0],
         plain_pelvis.error[0]
     );
+}
+
+#[test]
+fn the_acceleration_hold_adds_its_gradient_but_not_its_value() {
+    let (_, decoder, x) = random_case(1, 1);
+    let dev = Device::flex();
+    let zero = |j: Tensor<5>| j.sum_dim(4).sum_dim(3).sum_dim(2).sum_dim(1).reshape([1]) * 0.0;
+    let mut obj = HostObjective::new(&zero, &decoder, 1, FRAMES, &dev);
+    let head = extract_head(&x, FEATURE_DIM);
+    obj.hold_accel(&head, 1.0);
+    let mut g = vec![0.0; head.len()];
+    assert_eq!(obj.eval(&head, &mut g).unwrap(), vec![0.0]);
+    assert_eq!(
+        obj.penalty(),
+        &[0.0],
+        "the motion's own acceleration is free"
+    );
+    // Frame 5's joint heights pushed up: a one-frame jerk.
+    let mut jerked = head.clone();
+    let row = 5 * HEAD;
+    for c in (RIC.start + 1..HEAD).step_by(3) {
+        jerked[row + c] += 0.5;
+    }
+    let values = obj.eval(&jerked, &mut g).unwrap();
+    assert_eq!(values, vec![0.0], "the hold's value is not the program's");
+    let penalty = obj.penalty()[0];
+    assert!(penalty > 0.0);
+    // Finite differences of the penalty along the gradient.
+    let norm2: f32 = g.iter().map(|v| v * v).sum();
+    let h = 1e-3 / norm2.sqrt();
+    let moved: Vec<f32> = jerked.iter().zip(&g).map(|(x, g)| x - h * g).collect();
+    let mut scratch = vec![0.0; head.len()];
+    obj.eval(&moved, &mut scratch).unwrap();
+    let drop = penalty - obj.penalty()[0];
+    let predicted = h * norm2;
+    assert!(
+        (drop - predicted).abs() < 0.1 * predicted,
+        "penalty fell {drop}, the gradient predicts {predicted}"
+    );
+    obj.unlock_feet();
+    obj.eval(&jerked, &mut scratch).unwrap();
+    assert_eq!(obj.penalty(), &[0.0]);
+}
+
+#[test]
+fn the_acceleration_hold_spreads_a_keyframe_edit_over_its_neighbours() {
+    let bundle = tiny_bundle();
+    let guide = |accel_hold| {
+        Solver::new(GuideConfig {
+            steps: 50,
+            smooth_frames: 0.0,
+            fused: Some(FusedSettings {
+                accel_hold,
+                ..FusedSettings::default()
+            }),
+            ..GuideConfig::default()
+        })
+    };
+    let (raw, held) = (
+        keyframe_jump(&bundle, guide(0.0)),
+        keyframe_jump(&bundle, guide(0.25)),
+    );
+    assert!(
+        held < 0.7 * raw,
+        "relative jump: without {raw}, held {held}"
+    );
+    let mut knob = guide(0.0);
+    knob.set_knob("accel", -1.0).unwrap();
+    assert_refused(&bundle, knob, "acceleration hold");
 }
 
 #[test]

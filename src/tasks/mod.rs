@@ -16,7 +16,9 @@ pub mod report;
 pub mod suite;
 
 use crate::features::FEATURE_DIM;
-use crate::metrics::per_motion::{foot_skating_ratio, max_acceleration, max_bone_error};
+use crate::metrics::per_motion::{
+    PeakAcceleration, foot_skating_ratio, max_acceleration, max_bone_error, peak_acceleration,
+};
 use crate::motion::Motion;
 use crate::solve::{Prior, Progress, SolveRequest, Solver, solve};
 use burn::prelude::*;
@@ -93,6 +95,12 @@ pub struct CellOutcome {
     pub distances: Vec<f32>,
     /// The sample's foot-skating ratio.
     pub skating: f32,
+    /// The sample's peak joint acceleration and where it is.
+    pub accel: PeakAcceleration,
+    /// Frames from the peak acceleration to the nearest keyframe.
+    pub accel_to_keyframe: usize,
+    /// The sample's length in frames.
+    pub frames: usize,
 }
 
 /// One solve of `task` with `solver`, measured.
@@ -163,11 +171,22 @@ pub fn run_task(
                 .iter()
                 .zip(distances)
                 .zip(&firsts)
-                .map(|((cell, distances), motion)| CellOutcome {
-                    joint: cell.joint,
-                    density: cell.density.label(),
-                    distances,
-                    skating: foot_skating_ratio(motion),
+                .map(|((cell, distances), motion)| {
+                    let accel = peak_acceleration(motion);
+                    CellOutcome {
+                        joint: cell.joint,
+                        density: cell.density.label(),
+                        distances,
+                        skating: foot_skating_ratio(motion),
+                        accel,
+                        accel_to_keyframe: cell
+                            .frames
+                            .iter()
+                            .map(|f| f.abs_diff(accel.frame))
+                            .min()
+                            .unwrap_or(usize::MAX),
+                        frames: motion.len(),
+                    }
                 })
                 .collect();
         }

@@ -4,6 +4,7 @@
 use super::RunRow;
 use super::keyframe::{CONTROLLED, ControlErrors};
 use super::suite::Family;
+use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
@@ -195,40 +196,62 @@ fn per_task(md: &mut String, rows: &[&RunRow]) {
     }
 }
 
+/// Samples of one solver, grouped under a key (a controlled joint, a density, a place).
+type Grouped<K> = BTreeMap<K, BTreeMap<String, Vec<f32>>>;
+
+fn push<K: Ord>(map: &mut Grouped<K>, key: K, solver: &str, values: impl IntoIterator<Item = f32>) {
+    map.entry(key)
+        .or_default()
+        .entry(solver.to_string())
+        .or_default()
+        .extend(values);
+}
+
+/// Where a sample's peak acceleration is, as the rows of the report's table.
+const PEAK_PLACES: [&str; 4] = [
+    "at the controlled joint",
+    "at an ankle or toe",
+    "within 2 frames of a keyframe",
+    "in the first or last 2 frames",
+];
+
 fn keyframe_details(md: &mut String, rows: &[&RunRow]) {
     let solvers = solvers_in_order(rows);
-    // (joint or density label) → solver → distances.
-    let mut by_joint: BTreeMap<usize, BTreeMap<String, Vec<f32>>> = BTreeMap::new();
-    let mut by_density: Vec<(String, BTreeMap<String, Vec<f32>>)> = Vec::new();
-    // joint → solver → each sample's foot-skating ratio.
-    let mut skating: BTreeMap<usize, BTreeMap<String, Vec<f32>>> = BTreeMap::new();
+    let mut by_joint: Grouped<usize> = BTreeMap::new();
+    // Density labels in the order the cells bring them, for the rows' order.
+    let mut densities: Vec<String> = Vec::new();
+    let mut by_density: Grouped<usize> = BTreeMap::new();
+    // Each sample's foot-skating ratio and peak acceleration, by controlled joint.
+    let mut skating: Grouped<usize> = BTreeMap::new();
+    let mut accel: Grouped<usize> = BTreeMap::new();
+    let mut accel_by_density: Grouped<usize> = BTreeMap::new();
+    // 1 where the sample's peak is at that place, else 0: the mean is a share.
+    let mut places: Grouped<usize> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.failure.is_none()) {
+        let s = r.solver.as_str();
         for cell in &r.cells {
-            let (joint, density, d) = (&cell.joint, &cell.density, &cell.distances);
-            by_joint
-                .entry(*joint)
-                .or_default()
-                .entry(r.solver.clone())
-                .or_default()
-                .extend(d);
-            skating
-                .entry(*joint)
-                .or_default()
-                .entry(r.solver.clone())
-                .or_default()
-                .push(cell.skating);
-            let slot = match by_density.iter().position(|(l, _)| l == density) {
+            let density = match densities.iter().position(|l| *l == cell.density) {
                 Some(i) => i,
                 None => {
-                    by_density.push((density.clone(), BTreeMap::new()));
-                    by_density.len() - 1
+                    densities.push(cell.density.clone());
+                    densities.len() - 1
                 }
             };
-            by_density[slot]
-                .1
-                .entry(r.solver.clone())
-                .or_default()
-                .extend(d);
+            push(&mut by_joint, cell.joint, s, cell.distances.iter().copied());
+            push(&mut by_density, density, s, cell.distances.iter().copied());
+            push(&mut skating, cell.joint, s, [cell.skating]);
+            push(&mut accel, cell.joint, s, [cell.accel.value]);
+            push(&mut accel_by_density, density, s, [cell.accel.value]);
+            let at = cell.accel.frame;
+            let flags = [
+                cell.accel.joint == cell.joint,
+                FOOT_LEFT.contains(&cell.accel.joint) || FOOT_RIGHT.contains(&cell.accel.joint),
+                cell.accel_to_keyframe <= 2,
+                at < 2 || at + 2 >= cell.frames,
+            ];
+            for (place, flag) in flags.into_iter().enumerate() {
+                push(&mut places, place, s, [f32::from(u8::from(flag))]);
+            }
         }
     }
     let mean = |v: Option<&Vec<f32>>| {
@@ -241,41 +264,73 @@ fn keyframe_details(md: &mut String, rows: &[&RunRow]) {
         solvers.join(" | "),
         " --- |".repeat(solvers.len())
     );
-    let joint_rows =
-        |md: &mut String, title: &str, map: &BTreeMap<usize, BTreeMap<String, Vec<f32>>>| {
-            let _ = writeln!(md, "\n{title}:\n\n| joint {header}");
-            for (joint, per) in map {
-                let name = CONTROLLED
-                    .iter()
-                    .find(|c| c.0 == *joint)
-                    .map_or("?", |c| c.1);
-                let cells: Vec<String> = solvers.iter().map(|s| mean(per.get(s))).collect();
-                let _ = writeln!(md, "| {name} | {} |", cells.join(" | "));
-            }
-        };
-    joint_rows(
+    let table = |md: &mut String,
+                 title: &str,
+                 first: &str,
+                 map: &Grouped<usize>,
+                 name: &dyn Fn(usize) -> String| {
+        let _ = writeln!(md, "\n{title}:\n\n| {first} {header}");
+        for (key, per) in map {
+            let cells: Vec<String> = solvers.iter().map(|s| mean(per.get(s))).collect();
+            let _ = writeln!(md, "| {} | {} |", name(*key), cells.join(" | "));
+        }
+    };
+    let joint = |j: usize| {
+        CONTROLLED
+            .iter()
+            .find(|c| c.0 == j)
+            .map_or("?", |c| c.1)
+            .to_string()
+    };
+    let density = |i: usize| densities[i].clone();
+    table(
         md,
         "Average keyframe error (m) by controlled joint",
+        "joint",
         &by_joint,
+        &joint,
     );
-    joint_rows(
+    table(
         md,
         "Foot skating by controlled joint (PMG's ratio, mean over the samples that control it)",
+        "joint",
         &skating,
+        &joint,
     );
-    let _ = writeln!(
+    table(
         md,
-        "\nAverage keyframe error (m) by density:\n\n| density {header}"
+        "Average keyframe error (m) by density",
+        "density",
+        &by_density,
+        &density,
     );
-    for (label, per) in &by_density {
-        let cells: Vec<String> = solvers.iter().map(|s| mean(per.get(s))).collect();
-        let _ = writeln!(md, "| {label} | {} |", cells.join(" | "));
-    }
+    table(
+        md,
+        "Peak acceleration (m/frame²) by controlled joint",
+        "joint",
+        &accel,
+        &joint,
+    );
+    table(
+        md,
+        "Peak acceleration (m/frame²) by density",
+        "density",
+        &accel_by_density,
+        &density,
+    );
+    table(
+        md,
+        "Where each sample's peak acceleration is (share of the samples)",
+        "peak",
+        &places,
+        &|i| PEAK_PLACES[i].to_string(),
+    );
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::metrics::per_motion::PeakAcceleration;
     use crate::tasks::CellOutcome;
 
     fn row(solver: &str, cells: Vec<CellOutcome>) -> RunRow {
@@ -286,50 +341,74 @@ mod tests {
         }
     }
 
-    fn cell(joint: usize, distance: f32, skating: f32) -> CellOutcome {
+    /// A 60-frame sample keyed at frame 10, its peak acceleration `accel` at (joint, frame).
+    fn cell(joint: usize, distance: f32, skating: f32, accel: (f32, usize, usize)) -> CellOutcome {
         CellOutcome {
             joint,
             density: "1 frame".into(),
             distances: vec![distance],
             skating,
+            accel: PeakAcceleration {
+                value: accel.0,
+                joint: accel.1,
+                frame: accel.2,
+            },
+            accel_to_keyframe: accel.2.abs_diff(10),
+            frames: 60,
         }
     }
 
     #[test]
-    fn keyframe_details_give_each_controlled_joints_error_and_skating_per_solver() {
+    fn keyframe_details_give_each_controlled_joints_error_skating_and_acceleration_per_solver() {
         let (pelvis, left_foot) = (CONTROLLED[0].0, CONTROLLED[1].0);
         let a = row(
             "guide",
             vec![
-                cell(pelvis, 0.01, 0.1),
-                cell(pelvis, 0.03, 0.3),
-                cell(left_foot, 0.02, 0.5),
+                // Peak at the pelvis, on the keyframe.
+                cell(pelvis, 0.01, 0.1, (0.2, pelvis, 10)),
+                // Peak at the right toe (11), in the last frame but one.
+                cell(pelvis, 0.03, 0.3, (0.1, 11, 58)),
+                // Peak at the left ankle (7), 2 frames from the keyframe.
+                cell(left_foot, 0.02, 0.5, (0.3, 7, 12)),
             ],
         );
-        let b = row("plain", vec![cell(pelvis, 0.4, 0.0)]);
+        let b = row("plain", vec![cell(pelvis, 0.4, 0.0, (0.05, 15, 30))]);
         let mut md = String::new();
         keyframe_details(&mut md, &[&a, &b]);
-        let table = |title: &str| {
+        let table = |title: &str, rows: usize| {
             let at = md
                 .find(title)
                 .unwrap_or_else(|| panic!("no {title} in\n{md}"));
             md[at..]
                 .lines()
                 .skip(4)
-                .take(2)
+                .take(rows)
                 .collect::<Vec<_>>()
                 .join("\n")
         };
-        let errors = table("Average keyframe error (m) by controlled joint");
-        let skating = table("Foot skating by controlled joint");
         let (p, f) = (CONTROLLED[0].1, CONTROLLED[1].1);
         assert_eq!(
-            errors,
+            table("Average keyframe error (m) by controlled joint", 2),
             format!("| {p} | 0.020 | 0.400 |\n| {f} | 0.020 | — |")
         );
         assert_eq!(
-            skating,
+            table("Foot skating by controlled joint", 2),
             format!("| {p} | 0.200 | 0.000 |\n| {f} | 0.500 | — |")
+        );
+        assert_eq!(
+            table("Peak acceleration (m/frame²) by controlled joint", 2),
+            format!("| {p} | 0.150 | 0.050 |\n| {f} | 0.300 | — |")
+        );
+        assert_eq!(
+            table("Peak acceleration (m/frame²) by density", 1),
+            "| 1 frame | 0.200 | 0.050 |"
+        );
+        assert_eq!(
+            table("Where each sample's peak acceleration is", 4),
+            "| at the controlled joint | 0.333 | 0.000 |\n\
+             | at an ankle or toe | 0.667 | 0.000 |\n\
+             | within 2 frames of a keyframe | 0.667 | 0.000 |\n\
+             | in the first or last 2 frames | 0.333 | 0.000 |"
         );
     }
 }
