@@ -9,10 +9,10 @@
 //!                  μ ← μ − τ·Σ̂·g
 //! x_{t−1} ← μ + σ_t·ε   (no noise at the last step)
 //! ```
-//! mprog's additions, each on by default (but the acceleration hold) and turned back by its
-//! knob (why each was made,
-//! with the renders and numbers behind it: the book's "Six places where `guide` departs
-//! from OmniControl"):
+//! mprog's additions, each turned back by its knob and each on by default except the
+//! acceleration hold (`accel`, off; why each was made, with the renders and numbers behind
+//! it: the book's "Six places where `guide` departs from OmniControl" and its realism
+//! section):
 //! * early steps move only the root columns ([`FusedSettings::early_root_only`], `early_root`);
 //! * the last T_s steps keep bone lengths and planted feet ([`FusedSettings::keep_skeleton`],
 //!   [`super::bones`]), hold planted toes ([`FusedSettings::foot_lock`], [`super::feet`])
