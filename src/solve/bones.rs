@@ -298,51 +298,70 @@ mod tests {
         );
     }
 
-    #[test]
-    fn backward_matches_finite_differences() {
+    /// A bent, uneven pose so no bone is axis-aligned and lengths are off; `phase`
+    /// varies it.
+    fn bent(phase: f32) -> [[f32; 3]; NUM_JOINTS] {
         let mut pose = rest();
-        // A bent, uneven pose so no bone is axis-aligned and lengths are off.
         for (j, p) in pose.iter_mut().enumerate() {
-            let f = j as f32;
+            let f = j as f32 + phase;
             p[0] += 0.03 * (1.7 * f).sin();
             p[1] += 0.04 * (0.9 * f).cos();
             p[2] += 0.05 * (1.3 * f).sin();
         }
-        let row = row_of(&pose);
+        pose
+    }
+
+    /// `p.backward` against central differences of `Σ w·P(head)` with fixed pseudo-random
+    /// weights, on every column of `head`.
+    fn assert_backward_matches_finite_differences(
+        p: &mut SkeletonProjection,
+        head: &[f32],
+        case: &str,
+    ) {
+        let w: Vec<f32> = (0..head.len()).map(|i| (0.37 * i as f32).sin()).collect();
+        let mut out = vec![0.0; head.len()];
+        let mut loss = |h: &[f32], p: &mut SkeletonProjection| -> f64 {
+            p.forward(h, &mut out);
+            out.iter().zip(&w).map(|(o, w)| (o * w) as f64).sum()
+        };
+        loss(head, p);
+        let mut g = vec![0.0; head.len()];
+        p.backward(&w, &mut g);
+        let eps = 1e-3;
+        for i in 0..head.len() {
+            let (mut a, mut b) = (head.to_vec(), head.to_vec());
+            a[i] += eps;
+            b[i] -= eps;
+            let fd = (loss(&a, p) - loss(&b, p)) / (2.0 * eps as f64);
+            assert!(
+                (fd - g[i] as f64).abs() < 2e-2 * (1.0 + fd.abs()),
+                "{case}: column {} of frame {}: analytic {} vs numeric {fd}",
+                i % HEAD,
+                i / HEAD,
+                g[i]
+            );
+        }
+    }
+
+    #[test]
+    fn backward_matches_finite_differences() {
+        let row = row_of(&bent(0.0));
         for anchored in [false, true] {
             let setup = if anchored {
                 row_of(&rest())
             } else {
-                let mut air = rest();
-                air.iter_mut().for_each(|p| p[1] += 0.5);
-                row_of(&air)
+                lifted(rest(), 0.5)
             };
             let mut p = SkeletonProjection::new(&setup, 1);
             assert_eq!(p.anchored(), anchored as usize);
-            // Loss = Σ w·P(h) with fixed pseudo-random weights.
-            let w: Vec<f32> = (0..HEAD).map(|i| (0.37 * i as f32).sin()).collect();
-            let mut out = vec![0.0; HEAD];
-            let mut loss = |h: &[f32], p: &mut SkeletonProjection| -> f64 {
-                p.forward(h, &mut out);
-                out.iter().zip(&w).map(|(o, w)| (o * w) as f64).sum()
-            };
-            loss(&row, &mut p);
-            let mut g = vec![0.0; HEAD];
-            p.backward(&w, &mut g);
-            let eps = 1e-3;
-            for i in 0..HEAD {
-                let (mut a, mut b) = (row.clone(), row.clone());
-                a[i] += eps;
-                b[i] -= eps;
-                let fd = (loss(&a, &mut p) - loss(&b, &mut p)) / (2.0 * eps as f64);
-                assert!(
-                    (fd - g[i] as f64).abs() < 2e-2 * (1.0 + fd.abs()),
-                    "column {i} (anchored {anchored}): analytic {} vs numeric {fd}",
-                    g[i]
-                );
-            }
+            assert_backward_matches_finite_differences(
+                &mut p,
+                &row,
+                &format!("anchored {anchored}"),
+            );
         }
     }
+
     /// `pose` moved by `dy` vertically, as a head row.
     fn lifted(pose: [[f32; 3]; NUM_JOINTS], dy: f32) -> Vec<f32> {
         row_of(&pose.map(|p| [p[0], p[1] + dy, p[2]]))
@@ -389,16 +408,6 @@ mod tests {
     #[test]
     fn backward_matches_finite_differences_across_frames() {
         // Three bent frames, the middle one in the air: its shift comes from the other two.
-        let bent = |phase: f32| {
-            let mut pose = rest();
-            for (j, p) in pose.iter_mut().enumerate() {
-                let f = j as f32 + phase;
-                p[0] += 0.03 * (1.7 * f).sin();
-                p[1] += 0.04 * (0.9 * f).cos();
-                p[2] += 0.05 * (1.3 * f).sin();
-            }
-            pose
-        };
         let head: Vec<f32> = [(0.0, 0.0), (1.0, 0.3), (2.0, 0.0)]
             .into_iter()
             .flat_map(|(phase, dy)| lifted(bent(phase), dy))
@@ -409,28 +418,6 @@ mod tests {
             .collect();
         let mut p = SkeletonProjection::new(&setup, 3);
         assert_eq!(p.anchored(), 2);
-        let w: Vec<f32> = (0..head.len()).map(|i| (0.37 * i as f32).sin()).collect();
-        let mut out = vec![0.0; head.len()];
-        let mut loss = |h: &[f32], p: &mut SkeletonProjection| -> f64 {
-            p.forward(h, &mut out);
-            out.iter().zip(&w).map(|(o, w)| (o * w) as f64).sum()
-        };
-        loss(&head, &mut p);
-        let mut g = vec![0.0; head.len()];
-        p.backward(&w, &mut g);
-        let eps = 1e-3;
-        for i in 0..head.len() {
-            let (mut a, mut b) = (head.clone(), head.clone());
-            a[i] += eps;
-            b[i] -= eps;
-            let fd = (loss(&a, &mut p) - loss(&b, &mut p)) / (2.0 * eps as f64);
-            assert!(
-                (fd - g[i] as f64).abs() < 2e-2 * (1.0 + fd.abs()),
-                "column {} of frame {}: analytic {} vs numeric {fd}",
-                i % HEAD,
-                i / HEAD,
-                g[i]
-            );
-        }
+        assert_backward_matches_finite_differences(&mut p, &head, "three frames");
     }
 }
