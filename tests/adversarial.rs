@@ -199,6 +199,7 @@ fn tiny_bundle(dir: &Path) {
             train_seconds: 0.0,
             half_precision: false,
             text_encoder_id: None,
+            control_id: None,
         },
     };
     bundle.save(dir).unwrap();

@@ -67,6 +67,7 @@ fn bundle(dir: &Path, config: ModelConfig) {
             train_seconds: 0.0,
             half_precision: true,
             text_encoder_id: None,
+            control_id: None,
         },
     }
     .save(dir)

@@ -179,6 +179,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     // A realism ControlNet beside the weights steers `guide` (knob `realism`).
     let control = ControlNet::load(&dir, &bundle.model, bundle.manifest.half_precision, &device)
         .into_diagnostic()?;
+    let control_loaded = control.is_some();
     let several = prompts.len() > 1;
     for (person, prompt) in program.people().iter().zip(&prompts) {
         for line in bundle.text.report(prompt) {
@@ -288,6 +289,13 @@ pub fn run(args: RunArgs) -> Result<()> {
         "weights_id".into(),
         bundle.manifest.weights_id.clone().into(),
     );
+    if control_loaded {
+        let id = bundle.manifest.control_id.clone();
+        meta.insert(
+            "control_id".into(),
+            id.unwrap_or_else(|| "unnamed".into()).into(),
+        );
+    }
     meta.insert("prompts".into(), serde_json::json!(prompts));
     if let Some(plan) = &plan {
         meta.insert("edit".into(), plan.meta.clone().into());

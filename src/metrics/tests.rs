@@ -280,6 +280,7 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
             train_seconds: 0.0,
             half_precision: false,
             text_encoder_id: None,
+            control_id: None,
         },
     }
 }

@@ -48,6 +48,10 @@ pub struct Manifest {
     /// Weights id of the sentence encoder the model was trained with (sentence models).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub text_encoder_id: Option<String>,
+    /// Id of the realism ControlNet beside the weights (`control.safetensors`), when the
+    /// bundle has one: it changes what `guide` makes, so outputs record it too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control_id: Option<String>,
 }
 
 /// Errors while loading or saving a bundle.

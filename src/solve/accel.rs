@@ -13,6 +13,14 @@
 //! times a weight: `w · Σ_{t,j} (√(r² + ε²) − ε) / (N − 2)` with
 //! `r = max(0, |Δ²J_tj − Δ²J⁰_tj| − tol)`. The motion's own acceleration costs nothing;
 //! a change that is smooth over time costs little, a change of one frame a lot.
+//!
+//! `guide` sets it up at the start of each late step on the joints before the skeleton
+//! projection, but for the ankles and toes, which keep the projection's planted contacts
+//! ([`HostObjective::hold_accel`](super::host::HostObjective::hold_accel)): so the jerk the
+//! projection itself adds is held back too. It acts over the first
+//! [`ACCEL_HOLD_ITERATIONS`](super::guide::ACCEL_HOLD_ITERATIONS) iterations of each late
+//! step only: held over all 500 of the CLI's, a program that cannot be met spread its pull
+//! over the whole clip (book, solvers chapter).
 
 use crate::skeleton::NUM_JOINTS;
 

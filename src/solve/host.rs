@@ -23,7 +23,7 @@ use super::feet::FootLock;
 use super::{MotionError, SolveError};
 use crate::features::layout::RIC;
 use crate::scene::Placement;
-use crate::skeleton::NUM_JOINTS;
+use crate::skeleton::{FOOT_LEFT, FOOT_RIGHT, NUM_JOINTS};
 use burn::prelude::*;
 
 /// Feature columns that reach the joints.
@@ -223,12 +223,38 @@ impl<'a> HostObjective<'a> {
     }
 
     /// From now on add [`AccelHold`]'s penalty (weight `weight`) on the joint acceleration
-    /// added to these normalised heads (after the skeleton projection, if one is set up) to
-    /// what [`eval`](Self::eval) differentiates.
+    /// added to these normalised heads to what [`eval`](Self::eval) differentiates.
+    ///
+    /// With the skeleton projection set up, the reference is the heads' joints *before*
+    /// it, except the ankles and toes, which keep the projection's: it rebuilds the body
+    /// bone by bone, and the wrists take the elbows' wobble (it alone raised the keyframe
+    /// family's peak acceleration from 0.093 to 0.108), which the hold then holds back
+    /// too; the feet keep the floor contact it plants.
     pub fn hold_accel(&mut self, head: &[f32], weight: f32) {
         let people = self.placements.len();
-        let joints = self.world_joints(head).to_vec();
-        self.accel = Some(AccelHold::new(&joints, self.frames, people, weight));
+        let mut reference = self.world_joints(head).to_vec();
+        if let Some(projection) = self.projection.take() {
+            let raw = self.world_joints(head).to_vec();
+            self.projection = Some(projection);
+            for (kept, raw) in reference.chunks_exact_mut(J3).zip(raw.chunks_exact(J3)) {
+                for j in
+                    (0..NUM_JOINTS).filter(|j| !FOOT_LEFT.contains(j) && !FOOT_RIGHT.contains(j))
+                {
+                    kept[3 * j..3 * j + 3].copy_from_slice(&raw[3 * j..3 * j + 3]);
+                }
+            }
+            // Leave the objective's joints as the projection's.
+            self.world_joints(head);
+        }
+        self.accel = Some(AccelHold::new(&reference, self.frames, people, weight));
+    }
+
+    /// Stop adding the acceleration hold's penalty.
+    pub fn release_accel(&mut self) {
+        self.accel = None;
+        if !self.penalized() {
+            self.penalty.fill(0.0);
+        }
     }
 
     /// Stop adding the foot and acceleration penalties.

@@ -1031,6 +1031,12 @@ fn the_acceleration_hold_adds_its_gradient_but_not_its_value() {
     for c in (RIC.start + 1..HEAD).step_by(3) {
         jerked[row + c] += 0.5;
     }
+    // Released (after its iterations of a late step), it costs nothing again.
+    obj.release_accel();
+    assert_eq!(obj.eval(&jerked, &mut g).unwrap(), vec![0.0]);
+    assert!(g.iter().all(|v| *v == 0.0), "gradient after the release");
+    assert_eq!(obj.penalty(), &[0.0]);
+    obj.hold_accel(&head, 1.0);
     assert_penalty_follows_its_gradient(&mut obj, &jerked);
 }
 
@@ -1059,6 +1065,58 @@ fn the_acceleration_hold_spreads_a_keyframe_edit_over_its_neighbours() {
     let mut knob = guide(0.0);
     knob.set_knob("accel", -1.0).unwrap();
     assert_refused(&bundle, knob, "acceleration hold");
+}
+
+/// An error that every motion meets.
+fn always_met(j: Tensor<5>) -> Tensor<1> {
+    let [b, ..] = j.dims();
+    j.sum_dim(4).sum_dim(3).sum_dim(2).sum_dim(1).reshape([b]) * 0.0
+}
+
+/// Mean over frames of the largest joint acceleration (m/frame²) of a motion.
+fn mean_peak_acceleration(m: &crate::motion::Motion) -> f32 {
+    let f = &m.frames;
+    let peaks: Vec<f32> = (1..f.len() - 1)
+        .map(|t| {
+            (0..crate::skeleton::NUM_JOINTS)
+                .map(|j| (f[t + 1][j] - 2.0 * f[t][j] + f[t - 1][j]).length())
+                .fold(0.0, f32::max)
+        })
+        .collect();
+    peaks.iter().sum::<f32>() / peaks.len() as f32
+}
+
+#[test]
+fn where_the_program_is_met_the_hold_only_takes_back_the_projections_jerk() {
+    let bundle = tiny_bundle();
+    // Without the foot lock, whose own steps the hold's gradient would bend.
+    let guide = |accel_hold, keep_skeleton| {
+        Solver::new(GuideConfig {
+            steps: 20,
+            fused: Some(FusedSettings {
+                accel_hold,
+                keep_skeleton,
+                foot_lock: 0.0,
+                ..FusedSettings::default()
+            }),
+            ..GuideConfig::default()
+        })
+    };
+    let solve = |s: Solver| run(&bundle, &request(&["a person walks"], s), &always_met);
+    // Nothing to take back: the motion is left as it is.
+    let (free, held) = (solve(guide(0.0, false)), solve(guide(1.0, false)));
+    assert_eq!(free.motions[0][0].to_flat(), held.motions[0][0].to_flat());
+    // The projection rebuilds the body bone by bone and adds jerk; the hold's reference is
+    // the joints before it (the feet after it), so it smooths that jerk.
+    let (free, held) = (solve(guide(0.0, true)), solve(guide(1.0, true)));
+    let (a_free, a_held) = (
+        mean_peak_acceleration(&free.motions[0][0]),
+        mean_peak_acceleration(&held.motions[0][0]),
+    );
+    assert!(
+        a_held < a_free,
+        "mean peak acceleration: held {a_held}, free {a_free}"
+    );
 }
 
 #[test]

@@ -212,6 +212,7 @@ impl TrainRun<'_> {
                 TrainText::Words(_) => None,
                 TrainText::Sentences { prompts, .. } => Some(prompts.encoder.id().to_string()),
             },
+            control_id: None,
         };
         save_bundle_parts(
             &bundle,

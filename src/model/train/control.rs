@@ -43,7 +43,7 @@ use crate::model::denoiser::{Denoiser, DenoiserInput, Mdm};
 use crate::model::ema::ema_update;
 use crate::model::prompt::PromptEncoder;
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
-use crate::model::weights::{ModelBundle, model_from_safetensors};
+use crate::model::weights::{Manifest, ModelBundle, model_from_safetensors};
 use crate::skeleton::NUM_JOINTS;
 use burn::module::Module;
 use burn::optim::grad_clipping::GradientClippingConfig;
@@ -472,7 +472,10 @@ impl ControlTrainRun<'_> {
         let bundle = self.out.join("bundle");
         std::fs::create_dir_all(&bundle).map_err(|e| file_err(&bundle, e))?;
         copy_bundle_files(&self.base, &bundle)?;
-        ck.ema.save(&bundle, true).map_err(|e| file_err(&bundle, e))
+        ck.ema
+            .save(&bundle, true)
+            .map_err(|e| file_err(&bundle, e))?;
+        name_control(&bundle, ck.state.step)
     }
 }
 
@@ -519,6 +522,18 @@ pub fn hint_distance(joints: Tensor<4>, hint: &Hint) -> f32 {
 
 fn stat(v: &[f32], device: &Device) -> Tensor<3> {
     Tensor::from_data(TensorData::new(v.to_vec(), [1, 1, v.len()]), device)
+}
+
+/// Names the ControlNet in the bundle's manifest (`control_id`): outputs record it beside
+/// the base's weights id.
+fn name_control(bundle: &Path, step: usize) -> Result<(), TrainError> {
+    let path = bundle.join("manifest.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| file_err(&path, e))?;
+    let mut manifest: Manifest =
+        serde_json::from_str(&text).map_err(|e| file_err(&path, format!("bad manifest: {e}")))?;
+    manifest.control_id = Some(format!("controlnet-ema-step{step}"));
+    let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+    write_bytes_atomic(&path, json.as_bytes()).map_err(|e| file_err(&path, e))
 }
 
 /// Copies every file of a bundle folder (not its subfolders, not a ControlNet) to `to`.
@@ -686,6 +701,9 @@ mod tests {
         );
         let dev = Device::flex();
         let bundle = ModelBundle::load(&out.path().join("bundle"), &dev).unwrap();
+        // Outputs name the ControlNet beside the base's weights id.
+        let id = bundle.manifest.control_id.clone().unwrap_or_default();
+        assert!(id.starts_with("controlnet-ema-step"), "control id {id:?}");
         let control = ControlNet::load(&out.path().join("bundle"), &bundle.model, true, &dev)
             .unwrap()
             .expect("the bundle has its ControlNet");
