@@ -76,6 +76,16 @@ fn knobs_reach_the_solver_and_the_saved_meta() {
         meta.contains("steps: 10"),
         "the solver's settings are saved: {meta}"
     );
+    // The shipped bundle has a realism ControlNet: the output names it beside the weights.
+    let shipped = mprog::model::weights::default_model_dir();
+    let manifest = std::fs::read_to_string(shipped.join("manifest.json")).unwrap();
+    if shipped.join(mprog::model::control::CONTROL_FILE).exists() {
+        let manifest: serde_json::Value = serde_json::from_str(&manifest).unwrap();
+        let id = manifest["control_id"].as_str();
+        assert!(id.is_some(), "the manifest names the ControlNet");
+        let saved: serde_json::Value = serde_json::from_str(&meta).unwrap();
+        assert_eq!(saved["meta"]["control_id"].as_str(), id);
+    }
 
     let out = run(&[
         "run",
