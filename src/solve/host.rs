@@ -232,10 +232,14 @@ impl<'a> HostObjective<'a> {
     /// too; the feet keep the floor contact it plants.
     pub fn hold_accel(&mut self, head: &[f32], weight: f32) {
         let people = self.placements.len();
+        let projection = self.projection.take();
+        let raw = projection
+            .is_some()
+            .then(|| self.world_joints(head).to_vec());
+        self.projection = projection;
+        // Last, so the objective's joints stay the projection's.
         let mut reference = self.world_joints(head).to_vec();
-        if let Some(projection) = self.projection.take() {
-            let raw = self.world_joints(head).to_vec();
-            self.projection = Some(projection);
+        if let Some(raw) = raw {
             for (kept, raw) in reference.chunks_exact_mut(J3).zip(raw.chunks_exact(J3)) {
                 for j in
                     (0..NUM_JOINTS).filter(|j| !FOOT_LEFT.contains(j) && !FOOT_RIGHT.contains(j))
@@ -243,8 +247,6 @@ impl<'a> HostObjective<'a> {
                     kept[3 * j..3 * j + 3].copy_from_slice(&raw[3 * j..3 * j + 3]);
                 }
             }
-            // Leave the objective's joints as the projection's.
-            self.world_joints(head);
         }
         self.accel = Some(AccelHold::new(&reference, self.frames, people, weight));
     }
