@@ -22,6 +22,10 @@ pub struct TrainControlArgs {
     /// Run folder: checkpoints, loss log and the bundle with its ControlNet.
     #[arg(long)]
     out: PathBuf,
+    /// Start a new run from this bundle's `control.safetensors` rather than from zero: refit
+    /// a shipped ControlNet to a retrained base (ignored when `out` has a checkpoint).
+    #[arg(long)]
+    init_from: Option<PathBuf>,
     /// Stop after this many steps now (the run resumes later from `out`).
     #[arg(long)]
     steps: Option<usize>,
@@ -58,6 +62,7 @@ pub fn run(args: TrainControlArgs) -> Result<()> {
         base: args.base.clone(),
         config,
         out: args.out.clone(),
+        init_from: args.init_from.clone(),
         max_steps_now: args.steps,
         interrupt: interrupt.clone(),
         device: super::device()?,

@@ -183,6 +183,10 @@ pub struct ControlTrainRun<'a> {
     pub config: ControlTrainConfig,
     /// Output folder.
     pub out: PathBuf,
+    /// A bundle whose `control.safetensors` (f16) starts a new run instead of the zero
+    /// ControlNet: refitting a shipped ControlNet to a retrained base. Ignored when `out`
+    /// holds a checkpoint to resume.
+    pub init_from: Option<PathBuf>,
     /// Stop after this many steps now (None: until `config.steps`).
     pub max_steps_now: Option<usize>,
     /// Read between steps: when set, the run checkpoints and returns.
@@ -410,7 +414,12 @@ impl ControlTrainRun<'_> {
         let state_path = dir.join("state.json");
         let plain = &self.device;
         if !state_path.exists() {
-            let control = ControlNet::from_base(base, device);
+            let control = match &self.init_from {
+                None => ControlNet::from_base(base, device),
+                Some(from) => ControlNet::load(from, base, true, device)
+                    .map_err(|e| file_err(from, e))?
+                    .ok_or_else(|| file_err(from, format!("no {CONTROL_FILE} to start from")))?,
+            };
             return Ok(ControlState {
                 ema: control.valid().to_device(plain),
                 control,
@@ -656,6 +665,7 @@ mod tests {
                 ..ControlTrainConfig::default()
             },
             out: out.path().to_path_buf(),
+            init_from: None,
             max_steps_now: Some(steps),
             interrupt: Default::default(),
             device: Device::flex(),
@@ -802,6 +812,7 @@ mod tests {
                 ..ControlTrainConfig::default()
             },
             out: base_run.path().join("control"),
+            init_from: None,
             max_steps_now: Some(1),
             interrupt: Default::default(),
             device: dev.clone(),
@@ -832,6 +843,7 @@ mod tests {
             base: base_run.path().join("bundle"),
             config: ControlTrainConfig::default(),
             out: out.path().to_path_buf(),
+            init_from: None,
             max_steps_now: Some(1),
             interrupt: Default::default(),
             device: Device::flex(),
@@ -840,5 +852,69 @@ mod tests {
         .run(&|_, _, _| {})
         .unwrap_err();
         assert!(err.to_string().contains("mean/std"), "{err}");
+    }
+
+    #[test]
+    fn a_control_net_starts_from_another_bundles_control_net() {
+        let data = synthetic_dataset();
+        let base_run = train_tiny_base(&data, 2, 1);
+        let base = base_run.path().join("bundle");
+        let config = ControlTrainConfig {
+            batch_size: 2,
+            crop_frames: 8,
+            learning_rate: 1e-3,
+            warmup_steps: 1,
+            checkpoint_every: 100,
+            steps: 100,
+            ..ControlTrainConfig::default()
+        };
+        let (first, second) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        let run = |out: &Path, init_from: Option<PathBuf>, learning_rate: f64| ControlTrainRun {
+            data: &data,
+            base: base.clone(),
+            config: ControlTrainConfig {
+                learning_rate,
+                ..config.clone()
+            },
+            out: out.to_path_buf(),
+            init_from,
+            max_steps_now: Some(3),
+            interrupt: Default::default(),
+            device: Device::flex(),
+            after_checkpoint: None,
+        };
+        run(first.path(), None, 1e-3).run(&|_, _, _| {}).unwrap();
+        let shipped = first.path().join("bundle");
+        // A base bundle without a ControlNet cannot start one: refused, the file named.
+        let err = run(second.path(), Some(base.clone()), 1e-9)
+            .run(&|_, _, _| {})
+            .unwrap_err();
+        assert!(err.to_string().contains(CONTROL_FILE), "{err}");
+        // With a negligible step size the refit run keeps the shipped (f16) ControlNet.
+        run(second.path(), Some(shipped.clone()), 1e-9)
+            .run(&|_, _, _| {})
+            .unwrap();
+        let dev = Device::flex();
+        let bundle = ModelBundle::load(&base, &dev).unwrap();
+        let load = |dir: &Path, half| {
+            ControlNet::load(dir, &bundle.model, half, &dev)
+                .unwrap()
+                .unwrap()
+        };
+        let started = values(&load(&shipped, true));
+        let refit = values(&load(&second.path().join("ckpt"), false));
+        let gap = |a: &[f32], b: &[f32]| {
+            assert_eq!(a.len(), b.len());
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f32::max)
+        };
+        assert!(gap(&refit, &started) < 1e-6, "{}", gap(&refit, &started));
+        let fresh = values(&ControlNet::from_base(&bundle.model, &dev));
+        assert!(
+            gap(&started, &fresh) > 1e-4,
+            "the first run moved its ControlNet"
+        );
     }
 }
