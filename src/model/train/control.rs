@@ -416,9 +416,15 @@ impl ControlTrainRun<'_> {
         if !state_path.exists() {
             let control = match &self.init_from {
                 None => ControlNet::from_base(base, device),
-                Some(from) => ControlNet::load(from, base, true, device)
-                    .map_err(|e| file_err(from, e))?
-                    .ok_or_else(|| file_err(from, format!("no {CONTROL_FILE} to start from")))?,
+                Some(from) => {
+                    let control = ControlNet::load(from, base, true, device)
+                        .map_err(|e| file_err(from, e))?
+                        .ok_or_else(|| {
+                            file_err(from, format!("no {CONTROL_FILE} to start from"))
+                        })?;
+                    self.record_origin(from)?;
+                    control
+                }
             };
             return Ok(ControlState {
                 ema: control.valid().to_device(plain),
@@ -453,6 +459,19 @@ impl ControlTrainRun<'_> {
         })
     }
 
+    /// Keeps the id of the ControlNet a refit starts from (`<out>/origin.txt`), so that the
+    /// refit's bundles are named after it across resumes.
+    fn record_origin(&self, from: &Path) -> Result<(), TrainError> {
+        let path = from.join("manifest.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| file_err(&path, e))?;
+        let manifest: Manifest = serde_json::from_str(&text)
+            .map_err(|e| file_err(&path, format!("bad manifest: {e}")))?;
+        let origin = manifest.control_id.unwrap_or_else(|| "controlnet".into());
+        std::fs::create_dir_all(&self.out).map_err(|e| file_err(&self.out, e))?;
+        let dst = self.out.join(ORIGIN_FILE);
+        write_bytes_atomic(&dst, origin.as_bytes()).map_err(|e| file_err(&dst, e))
+    }
+
     fn save(&self, ck: &ControlState) -> Result<(), TrainError> {
         let new = self.out.join("ckpt.new");
         if new.exists() {
@@ -484,7 +503,13 @@ impl ControlTrainRun<'_> {
         ck.ema
             .save(&bundle, true)
             .map_err(|e| file_err(&bundle, e))?;
-        name_control(&bundle, ck.state.step)
+        let origin = self.out.join(ORIGIN_FILE);
+        let origin = if origin.exists() {
+            Some(std::fs::read_to_string(&origin).map_err(|e| file_err(&origin, e))?)
+        } else {
+            None
+        };
+        name_control(&bundle, origin.as_deref(), ck.state.step)
     }
 }
 
@@ -533,14 +558,20 @@ fn stat(v: &[f32], device: &Device) -> Tensor<3> {
     Tensor::from_data(TensorData::new(v.to_vec(), [1, 1, v.len()]), device)
 }
 
+/// Where a refit keeps the id of the ControlNet it started from.
+const ORIGIN_FILE: &str = "origin.txt";
+
 /// Names the ControlNet in the bundle's manifest (`control_id`): outputs record it beside
-/// the base's weights id.
-fn name_control(bundle: &Path, step: usize) -> Result<(), TrainError> {
+/// the base's weights id. A refit is named after the ControlNet it started from.
+fn name_control(bundle: &Path, origin: Option<&str>, step: usize) -> Result<(), TrainError> {
     let path = bundle.join("manifest.json");
     let text = std::fs::read_to_string(&path).map_err(|e| file_err(&path, e))?;
     let mut manifest: Manifest =
         serde_json::from_str(&text).map_err(|e| file_err(&path, format!("bad manifest: {e}")))?;
-    manifest.control_id = Some(format!("controlnet-ema-step{step}"));
+    manifest.control_id = Some(match origin {
+        Some(origin) => format!("{}-refit-ema-step{step}", origin.trim()),
+        None => format!("controlnet-ema-step{step}"),
+    });
     let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
     write_bytes_atomic(&path, json.as_bytes()).map_err(|e| file_err(&path, e))
 }
@@ -901,6 +932,19 @@ mod tests {
                 .unwrap()
                 .unwrap()
         };
+        let first_id = ModelBundle::load(&shipped, &dev)
+            .unwrap()
+            .manifest
+            .control_id;
+        let refit_id = ModelBundle::load(&second.path().join("bundle"), &dev)
+            .unwrap()
+            .manifest
+            .control_id;
+        assert_eq!(first_id.as_deref(), Some("controlnet-ema-step3"));
+        assert_eq!(
+            refit_id.as_deref(),
+            Some("controlnet-ema-step3-refit-ema-step3")
+        );
         let started = values(&load(&shipped, true));
         let refit = values(&load(&second.path().join("ckpt"), false));
         let gap = |a: &[f32], b: &[f32]| {
