@@ -172,12 +172,19 @@ pub fn model_from_safetensors(model: Mdm, bytes: Vec<u8>, half: bool) -> Result<
     module_from_safetensors(model, bytes, half, "model")
 }
 
+impl Manifest {
+    /// Reads a bundle's `manifest.json`.
+    pub fn read(path: &Path) -> Result<Manifest, WeightsError> {
+        serde_json::from_str(&read_text(path)?)
+            .map_err(|e| mismatch(path, format!("bad manifest: {e}")))
+    }
+}
+
 impl ModelBundle {
     /// Loads a bundle from `dir` onto `device`.
     pub fn load(dir: &Path, device: &Device) -> Result<ModelBundle, WeightsError> {
         let manifest_path = dir.join("manifest.json");
-        let manifest: Manifest = serde_json::from_str(&read_text(&manifest_path)?)
-            .map_err(|e| mismatch(&manifest_path, format!("bad manifest: {e}")))?;
+        let manifest = Manifest::read(&manifest_path)?;
         if manifest.version != BUNDLE_VERSION {
             return Err(mismatch(
                 &manifest_path,

@@ -462,7 +462,7 @@ impl ControlTrainRun<'_> {
     /// Keeps the id of the ControlNet a refit starts from (`<out>/origin.txt`), so that the
     /// refit's bundles are named after it across resumes.
     fn record_origin(&self, from: &Path) -> Result<(), TrainError> {
-        let origin = read_manifest(&from.join("manifest.json"))?
+        let origin = Manifest::read(&from.join("manifest.json"))?
             .control_id
             .unwrap_or_else(|| "controlnet".into());
         std::fs::create_dir_all(&self.out).map_err(|e| file_err(&self.out, e))?;
@@ -556,11 +556,6 @@ fn stat(v: &[f32], device: &Device) -> Tensor<3> {
     Tensor::from_data(TensorData::new(v.to_vec(), [1, 1, v.len()]), device)
 }
 
-fn read_manifest(path: &Path) -> Result<Manifest, TrainError> {
-    let text = std::fs::read_to_string(path).map_err(|e| file_err(path, e))?;
-    serde_json::from_str(&text).map_err(|e| file_err(path, format!("bad manifest: {e}")))
-}
-
 /// Where a refit keeps the id of the ControlNet it started from.
 const ORIGIN_FILE: &str = "origin.txt";
 
@@ -568,7 +563,7 @@ const ORIGIN_FILE: &str = "origin.txt";
 /// the base's weights id. A refit is named after the ControlNet it started from.
 fn name_control(bundle: &Path, origin: Option<&str>, step: usize) -> Result<(), TrainError> {
     let path = bundle.join("manifest.json");
-    let mut manifest = read_manifest(&path)?;
+    let mut manifest = Manifest::read(&path)?;
     manifest.control_id = Some(match origin {
         Some(origin) => format!("{}-refit-ema-step{step}", origin.trim()),
         None => format!("controlnet-ema-step{step}"),

@@ -98,6 +98,24 @@ pub enum TrainError {
     Invalid(String),
 }
 
+/// A bundle file that cannot be read or does not fit, named once.
+impl From<crate::model::weights::WeightsError> for TrainError {
+    fn from(e: crate::model::weights::WeightsError) -> Self {
+        use crate::model::weights::WeightsError as W;
+        match e {
+            W::Read { path, reason } => TrainError::File {
+                path,
+                reason: format!("cannot read: {reason}"),
+            },
+            W::Mismatch { path, reason } => TrainError::File { path, reason },
+            W::Write { path, reason } => TrainError::File {
+                path,
+                reason: format!("cannot write: {reason}"),
+            },
+        }
+    }
+}
+
 pub(super) fn file_err(path: &Path, e: impl std::fmt::Display) -> TrainError {
     TrainError::File {
         path: path.to_path_buf(),
