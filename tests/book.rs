@@ -198,7 +198,7 @@ fn prompt_examples_compile_and_cover_the_library() {
         EXAMPLES.len() + 1,
         "the language sketch and the worked examples"
     );
-    assert_eq!(EXAMPLES.len(), 5);
+    assert_eq!(EXAMPLES.len(), 7);
     for b in &blocks {
         let diags = check_source(&b.text, "prompt", &[]);
         assert!(

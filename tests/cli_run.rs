@@ -105,6 +105,73 @@ fn knobs_reach_the_solver_and_the_saved_meta() {
     );
 }
 
+/// Every run carries a plausibility report: a column in the table, the report after it,
+/// `meta.plausibility` and the `--report` JSON; `--strict` turns an implausible result
+/// into a failure and still writes the outputs.
+#[test]
+fn runs_report_plausibility_and_strict_fails_on_problems() {
+    let dir = tempfile::tempdir().unwrap();
+    let prog = program(
+        dir.path(),
+        "prompt \"a person walks forward\"\nlength 1s\nat 0.5s { l_hand.y > 2.5 m }\n",
+    );
+    let json = dir.path().join("out.json");
+    let report = dir.path().join("report.json");
+    let args = |strict: bool| {
+        let mut a = vec![
+            "run".to_string(),
+            prog.clone(),
+            "--no-baseline".into(),
+            "--knob".into(),
+            "steps=10".into(),
+            "--report".into(),
+            report.display().to_string(),
+            "-o".into(),
+            json.display().to_string(),
+        ];
+        if strict {
+            a.push("--strict".into());
+        }
+        a
+    };
+    let out = bin().args(args(false)).output().unwrap();
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("| plausibility |"), "{stdout}");
+    assert!(stdout.contains("plausibility: "), "{stdout}");
+    assert!(
+        stderr.contains("foot skating") && stderr.contains("(real clips: mean"),
+        "the skating figure says what it is measured against: {stderr}"
+    );
+    let saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let p = &saved["meta"]["plausibility"];
+    let ok = p["ok"].as_bool().expect("meta.plausibility.ok");
+    assert!(p["problems"].is_array(), "{p}");
+    assert_eq!(ok, p["problems"].as_array().unwrap().is_empty());
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["plausibility"]["ok"].as_bool(), Some(ok));
+    let column = r["statements"][0]["plausibility"].as_str().unwrap();
+    assert!(
+        column.starts_with("met") || column.starts_with("not met"),
+        "{column}"
+    );
+    for problem in p["problems"].as_array().unwrap() {
+        assert!(problem["frames"][1].as_u64() >= problem["frames"][0].as_u64());
+        assert!(problem["against"].as_str().is_some_and(|s| !s.is_empty()));
+    }
+    // The same run, deterministic, with --strict: fails exactly when it was implausible,
+    // and writes the outputs either way.
+    std::fs::remove_file(&json).unwrap();
+    let out = bin().args(args(true)).output().unwrap();
+    assert_eq!(out.status.success(), ok, "{}", text(&out).1);
+    assert!(json.exists(), "--strict still writes the outputs");
+    if !ok {
+        assert!(text(&out).1.contains("implausible result (--strict)"));
+    }
+}
+
 #[test]
 fn quick_task_bench_writes_a_table_for_the_chosen_solvers() {
     let dir = tempfile::tempdir().unwrap();
@@ -138,6 +205,7 @@ fn quick_task_bench_writes_a_table_for_the_chosen_solvers() {
         "## PMG tasks",
         "## Two-person contact",
         "| bones (m) |",
+        "| plausible |",
         "| guide |",
         "| plain |",
         "HSC-1",
@@ -224,6 +292,20 @@ fn gen_says_how_it_read_the_prompt() {
         "{stderr}"
     );
     assert!(!generate(&["--literal-prompt"]).contains("nearest captions"));
+    // Every motion gets its plausibility report, printed and in the sidecar's meta.
+    assert!(
+        stderr.contains("plausibility: ")
+            && stderr.contains("foot skating")
+            && stderr.contains("real clips"),
+        "{stderr}"
+    );
+    let sidecar: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out.meta.json")).unwrap())
+            .unwrap();
+    assert!(
+        sidecar["meta"]["plausibility"]["ok"].is_boolean(),
+        "{sidecar}"
+    );
 }
 
 #[test]

@@ -52,3 +52,41 @@ fn overrides_are_checked() {
     assert!(bad.items.iter().any(|d| d.code == "mprog::unknown_param"
         && d.help.as_deref() == Some("did you mean `diameter`?")));
 }
+
+#[test]
+fn keyframe_pose_warns_only_for_end_postures() {
+    let codes = |src: &str| -> Vec<&'static str> {
+        let d = check_source(src, "x.mprog", &[]);
+        assert!(!d.has_errors(), "{}", d.render_plain());
+        let mut v: Vec<&str> = d
+            .items
+            .iter()
+            .map(|i| i.code)
+            .filter(|c| *c == "mprog::keyframe_pose")
+            .collect();
+        v.dedup();
+        v
+    };
+    // Contacts, ground positions, facing, relative heights, the feet, a single hand,
+    // keyframes inside the motion, and end states held over a window: no warning.
+    let quiet = "length 4s\n\
+        at end {\n\
+            dist(r_hand, [-0.3, 1.1, 0.4]) < 5 cm\n\
+            groundDist(pelvis, [0, 0, 1]) < 10 cm\n\
+            dot(facing(), [0, 0, -1]) > 0.9\n\
+            r_hand.y > head.y\n\
+            footHeight(me) < 5 cm\n\
+        }\n\
+        at mid { pelvis.y < 60 cm }\n\
+        during end - 0.5s..end + 1 { pelvis.y < 60 cm }\n";
+    assert!(codes(quiet).is_empty());
+    // The pelvis's height, or two hands' heights, on the last frame: a posture.
+    assert_eq!(
+        codes("length 4s\nat end { pelvis.y < 60 cm }\n"),
+        ["mprog::keyframe_pose"]
+    );
+    assert_eq!(
+        codes("length 4s\nat end { l_hand.y > 1.8 m\n r_hand.y > 1.8 m }\n"),
+        ["mprog::keyframe_pose"]
+    );
+}

@@ -522,7 +522,153 @@ fn cases() -> Vec<(&'static str, usize, &'static str, Reference)> {
                 total + over_all(|t| relu(1.0 - mass_center(m, 1, t, true)[1]))
             },
         ),
+        (
+            "a def sees the lets above it",
+            1,
+            "let tall = 1.6 m\ndef atHeight(j) = j.y == tall\nalways { atHeight(head) }",
+            |m| over_all(|t| (p(m, 0, t, 15)[1] - 1.6).abs()),
+        ),
+        (
+            "time",
+            1,
+            "always { head.y == 1.5 m + 0.5 m/s * time }\nat end { pelvis.z == 1 m/s * time@0.25s }",
+            |m| {
+                over_all(|t| (p(m, 0, t, 15)[1] - (1.5 + 0.5 * t as f64 / 20.0)).abs())
+                    + (p(m, 0, F - 1, 0)[2] - 0.25).abs()
+            },
+        ),
+        (
+            "time in trig and conditions",
+            1,
+            "always { r_hand.x == 0.3 * cos(180 deg/s * time) }\nif time > 0.3s { head.y > 1.7 m }",
+            |m| {
+                let w = std::f64::consts::PI;
+                over_all(|t| (p(m, 0, t, 21)[0] - 0.3 * (w * t as f64 / 20.0).cos()).abs())
+                    + mean((7..F).map(|t| relu(1.7 - p(m, 0, t, 15)[1])))
+            },
+        ),
+        (
+            "body axes and gaze",
+            1,
+            "always { bodyFront() == [0, 0, 1] }\nalways { dot(bodyLeft(), [1, 0, 0]) > 1 }\nat end { bodyUp() == [0, 1, 0] }\nalways { gaze() == [0, 0, 1] }",
+            |m| {
+                let last = body_axes(m, 0, F - 1);
+                over_all(|t| norm(sub(body_axes(m, 0, t)[2], [0.0, 0.0, 1.0])))
+                    + over_all(|t| relu(1.0 - body_axes(m, 0, t)[0][0]))
+                    + norm(sub(last[1], [0.0, 1.0, 0.0]))
+                    + over_all(|t| norm(sub(gaze(m, 0, t), [0.0, 0.0, 1.0])))
+            },
+        ),
+        (
+            "body axes of people",
+            2,
+            "people a, b\nalways { dot(bodyFront(a), bodyFront(b)) > 0 }\nalways { gaze(b).y > 0 }",
+            |m| {
+                over_all(|t| relu(-dot(body_axes(m, 0, t)[2], body_axes(m, 1, t)[2])))
+                    + over_all(|t| relu(-gaze(m, 1, t)[1]))
+            },
+        ),
     ]
+}
+
+/// The torso's frame `[left, up, front]` of `person` at frame `t`.
+fn body_axes(m: &Motion, person: usize, t: usize) -> [[f64; 3]; 3] {
+    let j = |k| p(m, person, t, k);
+    let across = add(normalize(sub(j(1), j(2))), normalize(sub(j(16), j(17))));
+    let up = normalize(sub(j(12), j(0)));
+    let front = normalize(cross(across, up));
+    [cross(up, front), up, front]
+}
+
+/// The head's direction: perpendicular to the shoulders and the neck→head bone, raised 25°.
+fn gaze(m: &Motion, person: usize, t: usize) -> [f64; 3] {
+    let j = |k| p(m, person, t, k);
+    let l = normalize(sub(j(16), j(17)));
+    let g0 = normalize(cross(l, sub(j(15), j(12))));
+    let (s, c) = 25f64.to_radians().sin_cos();
+    add(scale(g0, c), scale(cross(g0, l), s))
+}
+
+/// The rest pose (facing +Z, left at +X) with the head level: the neck→head bone leaning
+/// 25° forward, as in HumanML3D's upright frames.
+fn standing() -> [[f64; 3]; 22] {
+    let rest = mprog::skeleton::rest_pose();
+    let mut pose: [[f64; 3]; 22] =
+        std::array::from_fn(|j| [rest[j].x, rest[j].y, rest[j].z].map(f64::from));
+    let (s, c) = 25f64.to_radians().sin_cos();
+    pose[15] = add(pose[12], [0.0, 0.103 * c, 0.103 * s]);
+    // Level shoulders (the rest offsets put the right one 9 mm higher).
+    pose[17][1] = pose[16][1];
+    pose
+}
+
+/// Total error of `body` (after a length line) on `frames` copies of `pose(t)`.
+fn error_on(body: &str, pose: impl Fn(usize) -> [[f64; 3]; 22]) -> f64 {
+    let prog = program(&format!("length {F} frames\n{body}\n"));
+    let m: Motion = vec![(0..F).map(pose).collect()];
+    let (data, shape) = flat(&m);
+    eval(&prog, &data, shape).0
+}
+
+#[test]
+fn body_axes_of_the_rest_pose_and_of_lying_on_the_back() {
+    let axes = "always { bodyFront() == [0, 0, 1] and bodyLeft() == [1, 0, 0] and bodyUp() == [0, 1, 0] and gaze() == [0, 0, 1] }";
+    assert!(error_on(axes, |_| standing()) < 1e-5);
+    // Lying on the back, head towards -Z: the rest pose turned 90° about X (y → z, z → -y).
+    let lying = |_| standing().map(|[x, y, z]| [x, z, -y]);
+    let on_back = "always { bodyFront() == [0, 1, 0] and bodyLeft() == [1, 0, 0] and bodyUp() == [0, 0, -1] }";
+    assert!(error_on(on_back, lying) < 1e-5);
+    // Standing, the same program is wrong by about two right angles' chords.
+    assert!(error_on(on_back, |_| standing()) > 2.0);
+}
+
+#[test]
+fn gaze_follows_the_upper_body_turning_and_the_head_tipping() {
+    // Looking over the left shoulder, as far as joints show it: everything above the
+    // middle of the spine turned 60° to the left (towards +X) about the vertical.
+    let (s, c) = 60f64.to_radians().sin_cos();
+    let turned = |_| {
+        let mut pose = standing();
+        let pivot = pose[9];
+        for j in [9, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21] {
+            let [x, y, z] = sub(pose[j], pivot);
+            pose[j] = add(pivot, [x * c + z * s, y, -x * s + z * c]);
+        }
+        pose
+    };
+    let over_left = "always { gaze() == [0.8660254, 0, 0.5] }";
+    assert!(error_on(over_left, turned) < 1e-4);
+    assert!(error_on(over_left, |_| standing()) > 0.5);
+    // Tipping the head 30° forward (chin to chest) looks 30° down.
+    let (s30, c30) = 30f64.to_radians().sin_cos();
+    let nodding = |_| {
+        let mut pose = standing();
+        let (s, c) = 55f64.to_radians().sin_cos();
+        pose[15] = add(pose[12], [0.0, 0.103 * c, 0.103 * s]);
+        pose
+    };
+    let down = format!("always {{ gaze() == [0, {}, {}] }}", -s30, c30);
+    assert!(error_on(&down, nodding) < 1e-4);
+}
+
+#[test]
+fn time_drives_a_circle_met_exactly_by_a_motion_made_for_it() {
+    // The right wrist goes round a 30 cm circle at 1.2 m, half a turn per second.
+    let circle = "always { dist(r_hand, [0.3*cos(180 deg/s * time), 1.2, 0.3*sin(180 deg/s * time)]) < 5 mm }";
+    let on_circle = |t: usize| {
+        let mut pose = standing();
+        let a = std::f64::consts::PI * t as f64 / 20.0;
+        pose[21] = [0.3 * a.cos(), 1.2, 0.3 * a.sin()];
+        pose
+    };
+    assert!(error_on(circle, on_circle) < 1e-6);
+    // A quarter turn late is wrong on every frame.
+    let late = |t: usize| on_circle(t + 10);
+    assert!(error_on(circle, late) > 0.3);
+    // `time` carries no gradient of its own: the circle's gradient is the wrist's.
+    let prog = program(&format!("length {F} frames\n{circle}\n"));
+    let m: Motion = vec![(0..F).map(late).collect()];
+    check_gradient(&prog, &m, "time circle");
 }
 
 #[test]

@@ -3,7 +3,6 @@
 
 use clap::{Args, ValueEnum};
 use mprog::model::prompt::PromptEncoder;
-use mprog::model::sentence::FAR_COSINE;
 use std::path::PathBuf;
 
 /// Output format of `mprog check`.
@@ -55,24 +54,24 @@ pub fn sentence_reader(dir: &std::path::Path) -> Option<PromptEncoder> {
     matches!(bundle.text, PromptEncoder::Sentences(_)).then_some(bundle.text)
 }
 
-/// The nearest-caption lookup of a sentence model, for [`mprog::lang::with_far_prompts`].
-pub fn nearest_caption_of(text: PromptEncoder) -> Box<mprog::lang::NearestCaption> {
-    Box::new(move |prompt: &str| text.nearest_caption(prompt).map(|n| (n.caption, n.cosine)))
+/// What a sentence model says of a prompt (the lines `run` prints), for
+/// [`mprog::lang::with_far_prompts`].
+pub fn prompt_report_of(text: PromptEncoder) -> Box<mprog::lang::PromptReport> {
+    Box::new(move |prompt: &str| text.report(prompt))
 }
 
 /// Runs `mprog check`; returns whether every file is free of errors.
 pub fn run(args: &CheckArgs) -> miette::Result<bool> {
     let mut all_ok = true;
     let mut json = Vec::new();
-    let reader =
-        sentence_reader(&mprog::model::weights::default_model_dir()).map(nearest_caption_of);
+    let reader = sentence_reader(&mprog::model::weights::default_model_dir()).map(prompt_report_of);
     for path in &args.files {
         let name = path.display().to_string();
         let source = std::fs::read_to_string(path)
             .map_err(|e| miette::miette!("cannot read {name}: {e}"))?;
         let diags = mprog::lang::check_source(&source, &name, &args.set);
         let diags = match &reader {
-            Some(nearest) => mprog::lang::with_far_prompts(diags, &source, nearest, FAR_COSINE),
+            Some(report) => mprog::lang::with_far_prompts(diags, &source, report),
             None => diags,
         };
         let ok = !diags.has_errors();

@@ -1,7 +1,7 @@
 //! `mprog data build`: convert a folder of BVH (and ASF/AMC) files into a training set.
 
 use indicatif::{ProgressBar, ProgressStyle};
-use miette::{IntoDiagnostic, Result};
+use miette::{IntoDiagnostic, Result, WrapErr};
 use mprog::dataset::build::{BuildOptions, build_dataset_report, find_motion_files};
 use std::path::PathBuf;
 
@@ -12,6 +12,9 @@ pub enum DataCommand {
     Build(BuildArgs),
     /// Write one clip of a training set as a motion file or picture.
     Show(ShowArgs),
+    /// Measure how a training set's clips move (per-joint speed and acceleration, floor,
+    /// foot skating, rigid distances): the envelope plausibility reports check against.
+    Envelope(EnvelopeArgs),
 }
 
 /// Arguments of `mprog data build`.
@@ -39,6 +42,7 @@ pub fn run(cmd: DataCommand) -> Result<()> {
     match cmd {
         DataCommand::Build(args) => build(args),
         DataCommand::Show(args) => show(args),
+        DataCommand::Envelope(args) => envelope(args),
     }
 }
 
@@ -120,4 +124,71 @@ fn show(args: ShowArgs) -> Result<()> {
     let motion = mprog::motion::Motion::from_flat(data.clip_joints(clip));
     let title = format!("{} ({:?}): {}", clip.name, clip.split, clip.captions[0]);
     super::io::write_outputs(&args.out, &[motion], &Default::default(), &title)
+}
+
+/// Arguments of `mprog data envelope`.
+#[derive(clap::Args)]
+pub struct EnvelopeArgs {
+    /// Training set folder (`mprog data build`'s output; every clip of every split is
+    /// measured, mirrored copies included).
+    #[arg(long)]
+    data: PathBuf,
+    /// Where to write it (JSON, atomically); a model bundle reads `<bundle>/envelope.json`.
+    #[arg(short, long)]
+    out: PathBuf,
+}
+
+fn envelope(args: EnvelopeArgs) -> Result<()> {
+    use mprog::metrics::plausibility::measure_envelope;
+    let data = mprog::dataset::Dataset::load(&args.data).into_diagnostic()?;
+    let clips: Vec<mprog::motion::Motion> = data
+        .index
+        .clips
+        .iter()
+        .map(|c| mprog::motion::Motion::from_flat(data.clip_joints(c)))
+        .collect();
+    let source = args.data.display().to_string();
+    let env = measure_envelope(clips.iter(), &source);
+    env.save(&args.out)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("writing {}", args.out.display()))?;
+    println!("{}", env.source);
+    println!(
+        "| joint | accel p50 | p99.9 | clip peak p50 | p99 | max (m/frame²) | speed p99.9 | clip peak p99 | max (m/s) |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    for (j, name) in mprog::skeleton::JOINT_NAMES.iter().enumerate() {
+        let (a, ap, v, vp) = (
+            &env.accel[j],
+            &env.accel_peak[j],
+            &env.speed[j],
+            &env.speed_peak[j],
+        );
+        println!(
+            "| {name} | {:.4} | {:.4} | {:.4} | {:.4} | {:.3} | {:.2} | {:.2} | {:.1} |",
+            a.p50, a.p99_9, ap.p50, ap.p99, a.max, v.p99_9, vp.p99, v.max
+        );
+    }
+    let f = &env.floor;
+    println!(
+        "lowest joint height (m): min {:.3}, p0.1 {:.3}, p1 {:.3}, p50 {:.3}",
+        f.min, f.p0_1, f.p1, f.p50
+    );
+    for (what, s) in [
+        ("every clip", &env.skating),
+        ("clips moving > 0.5 m/s", &env.skating_moving),
+    ] {
+        println!(
+            "foot skating per clip ({what}): mean {:.4}, p50 {:.4}, p95 {:.4}, p99 {:.4}, max {:.4}",
+            s.mean, s.p50, s.p95, s.p99, s.max
+        );
+    }
+    for r in &env.rigid {
+        println!(
+            "{:48} rest {:.3} m; ratio min {:.3}, p0.1 {:.3}, p50 {:.3}, p99.9 {:.3}, max {:.3}",
+            r.name, r.rest, r.ratio.min, r.ratio.p0_1, r.ratio.p50, r.ratio.p99_9, r.ratio.max
+        );
+    }
+    println!("wrote {}", args.out.display());
+    Ok(())
 }

@@ -61,6 +61,11 @@ pub struct GenArgs {
     /// caption (by default such a prompt is replaced by the mean of its nearest captions).
     #[arg(long)]
     literal_prompt: bool,
+    /// Exit non-zero when a motion's plausibility report finds a problem (a snap, the
+    /// floor, foot skating, a deformed body, walking backwards); every motion is written
+    /// all the same, with its report in the meta.
+    #[arg(long)]
+    strict: bool,
     #[command(flatten)]
     export: super::export::ExportArgs,
 }
@@ -181,6 +186,18 @@ pub fn run(args: GenArgs) -> Result<()> {
         "weights_id".into(),
         bundle.manifest.weights_id.clone().into(),
     );
+    let envelope = super::plausible::envelope(&dir)?;
+    let reports: Vec<_> = out
+        .motions
+        .iter()
+        .map(|m| {
+            mprog::metrics::plausibility::check(
+                std::slice::from_ref(m),
+                &[Some(args.text.clone())],
+                &envelope,
+            )
+        })
+        .collect();
     let count = out.motions.len();
     for (i, motion) in out.motions.iter().enumerate() {
         if interrupt.is_requested() {
@@ -191,6 +208,7 @@ pub fn run(args: GenArgs) -> Result<()> {
         }
         let mut m = meta.clone();
         m.insert("sample".into(), i.into());
+        m.insert("plausibility".into(), reports[i].to_json());
         write_outputs_with(
             &numbered(&args.out, i, count),
             std::slice::from_ref(motion),
@@ -201,10 +219,27 @@ pub fn run(args: GenArgs) -> Result<()> {
     }
     let metrics: Vec<MotionMetrics> = out.motions.iter().map(MotionMetrics::of).collect();
     eprint!("{}", motions_markdown(&metrics));
+    for (i, r) in reports.iter().enumerate() {
+        for line in r.lines() {
+            if count > 1 {
+                eprintln!("motion {i}: {line}");
+            } else {
+                eprintln!("{line}");
+            }
+        }
+    }
     eprintln!(
         "generated {count} motion(s) of {frames} frames in {:.1} s (weights {})",
         started.elapsed().as_secs_f64(),
         bundle.manifest.weights_id
     );
+    let bad: usize = reports.iter().filter(|r| !r.ok).count();
+    if args.strict && bad > 0 {
+        return Err(miette::miette!(
+            help =
+                "the motions were written; the problems are listed above and in meta.plausibility",
+            "implausible result (--strict): {bad} of {count} motion(s) have problems"
+        ));
+    }
     Ok(())
 }

@@ -39,13 +39,9 @@ pub fn run(args: McpArgs) -> Result<()> {
         model: args.model,
         time_limit: std::time::Duration::from_secs(args.time_limit.max(1)),
         card: Some(card),
-        // `check` warns on prompts far from the model's captions (sentence models).
-        far_prompts: super::check::sentence_reader(&model_dir).map(|text| {
-            (
-                std::sync::Arc::from(super::check::nearest_caption_of(text)),
-                mprog::model::sentence::FAR_COSINE,
-            )
-        }),
+        // `check` warns on every prompt `run` would (sentence models).
+        far_prompts: super::check::sentence_reader(&model_dir)
+            .map(|text| std::sync::Arc::from(super::check::prompt_report_of(text))),
     };
     mprog::mcp::serve_stdio(&config).map_err(|e| miette!("{e}"))
 }

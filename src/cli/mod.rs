@@ -12,6 +12,7 @@ pub mod export;
 pub mod generate;
 pub mod io;
 pub mod mcp;
+pub mod plausible;
 pub mod repl;
 pub mod run;
 pub mod score;

@@ -18,13 +18,18 @@ use std::path::PathBuf;
 
 /// One line on how physical the result is: a solver that stretched limbs, shook joints or
 /// slid the feet to meet the program shows here (the numbers `mprog bench tasks` reports).
-fn body_summary(people: &[Motion]) -> String {
+/// The skating figure says what it is measured against: the envelope's real clips.
+fn body_summary(people: &[Motion], env: &mprog::dataset::envelope::Envelope) -> String {
     use mprog::metrics::per_motion::{foot_skating_ratio, max_acceleration, max_bone_error};
     let worst = |f: fn(&Motion) -> f32| people.iter().map(f).fold(0.0, f32::max);
     format!(
-        "body: bone lengths within {:.1} cm of the skeleton's, foot skating {:.2}, max joint acceleration {:.3} m/frame²{}",
+        "body: bone lengths within {:.1} cm of the skeleton's, foot skating {:.3} (real clips: mean {:.3}, p95 {:.3}; moving ones: mean {:.3}, p95 {:.3}), max joint acceleration {:.3} m/frame²{}",
         100.0 * worst(max_bone_error),
         worst(foot_skating_ratio),
+        env.skating.mean,
+        env.skating.p95,
+        env.skating_moving.mean,
+        env.skating_moving.p95,
         worst(max_acceleration),
         if people.len() > 1 {
             " (worst person)"
@@ -69,6 +74,11 @@ pub struct RunArgs {
     /// files written as JSON, for tools (`mprog mcp` reads it).
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Exit non-zero when the plausibility report finds a problem (a snap, the floor,
+    /// foot skating, people overlapping, a deformed body, walking backwards); the outputs
+    /// are written all the same, with the report in their meta.
+    #[arg(long)]
+    strict: bool,
     /// Outputs; each one's extension picks its kind (`--help` lists them).
     #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
@@ -180,6 +190,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let control = ControlNet::load(&dir, &bundle.model, bundle.manifest.half_precision, &device)
         .into_diagnostic()?;
     let control_loaded = control.is_some();
+    let envelope = super::plausible::envelope(&dir)?;
     let several = prompts.len() > 1;
     for (person, prompt) in program.people().iter().zip(&prompts) {
         for line in bundle.text.report(prompt) {
@@ -227,10 +238,27 @@ pub fn run(args: RunArgs) -> Result<()> {
             &device,
             "unguided",
         )?;
-        Some((per_statement(&program, &r.motions[0], &device)?, r.seconds))
+        Some((
+            per_statement(&program, &r.motions[0], &device)?,
+            r.seconds,
+            r.motions[0].clone(),
+        ))
     };
-    println!("| line | statement | unit | unguided | {} |", solver.name());
-    println!("| --- | --- | --- | --- | --- |");
+    let prompt_list: Vec<Option<String>> = prompts.iter().cloned().map(Some).collect();
+    let mut plausibility = mprog::metrics::plausibility::check(people, &prompt_list, &envelope);
+    let active = super::plausible::active_frames(
+        &program,
+        people,
+        baseline.as_ref().map(|(_, _, m)| m.as_slice()),
+        &device,
+    )?;
+    super::plausible::attach_statements(&mut plausibility, &program, &active);
+    let column = |i: usize| super::plausible::column(&program, i, guided[i], &plausibility);
+    println!(
+        "| line | statement | unit | unguided | {} | plausibility |",
+        solver.name()
+    );
+    println!("| --- | --- | --- | --- | --- | --- |");
     for (i, s) in program.statements().iter().enumerate() {
         let text = s
             .label
@@ -239,19 +267,35 @@ pub fn run(args: RunArgs) -> Result<()> {
             .trim();
         let base = baseline
             .as_ref()
-            .map_or("—".into(), |(b, _)| format!("{:.4}", b[i]));
+            .map_or("—".into(), |(b, _, _)| format!("{:.4}", b[i]));
         println!(
-            "| {} | `{text}` | {} | {base} | {:.4} |",
-            s.line, s.unit, guided[i]
+            "| {} | `{text}` | {} | {base} | {:.4} | {} |",
+            s.line,
+            s.unit,
+            guided[i],
+            column(i)
         );
     }
     let total: f32 = guided.iter().sum();
-    let base_total = baseline.as_ref().map_or("—".into(), |(b, _)| {
+    let base_total = baseline.as_ref().map_or("—".into(), |(b, _, _)| {
         format!("{:.4}", b.iter().sum::<f32>())
     });
-    println!("| | **total** | | {base_total} | {total:.4} |");
+    let verdict = if plausibility.ok {
+        "plausible"
+    } else {
+        "implausible"
+    };
+    println!("| | **total** | | {base_total} | {total:.4} | {verdict} |");
+    super::plausible::print(&plausibility);
+    // The unguided sample's report tells what the steering added.
+    let unguided_plausibility = baseline
+        .as_ref()
+        .map(|(_, _, m)| mprog::metrics::plausibility::check(m, &prompt_list, &envelope));
+    if let Some(u) = &unguided_plausibility {
+        println!("{}", super::plausible::summary("the unguided sample", u));
+    }
     // After the table, so a terminal does not interleave them with its rows.
-    if let Some((base, _)) = &baseline {
+    if let Some((base, _, _)) = &baseline {
         for (s, b) in program.statements().iter().zip(base) {
             if *b <= 0.0 && ["<", ">", "<=", ">="].iter().any(|op| s.label.contains(op)) {
                 eprintln!(
@@ -262,14 +306,14 @@ pub fn run(args: RunArgs) -> Result<()> {
         }
     }
     match &baseline {
-        Some((_, s)) => eprintln!(
+        Some((_, s, _)) => eprintln!(
             "{}: {:.1} s (unguided: {s:.1} s)",
             solver.name(),
             result.seconds
         ),
         None => eprintln!("{}: {:.1} s", solver.name(), result.seconds),
     }
-    eprintln!("{}", body_summary(people));
+    eprintln!("{}", body_summary(people, &envelope));
     let mut meta = Meta::new();
     meta.insert(
         "program".into(),
@@ -301,6 +345,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         meta.insert("edit".into(), plan.meta.clone().into());
     }
     meta.extend(mprog::view::program::program_meta(&program, people, &device).into_diagnostic()?);
+    meta.insert("plausibility".into(), plausibility.to_json());
     let written = write_outputs_with(
         &args.out,
         people,
@@ -318,8 +363,9 @@ pub fn run(args: RunArgs) -> Result<()> {
                     "line": s.line,
                     "statement": s.label.split_once(": ").map_or(s.label.as_str(), |(_, t)| t).trim(),
                     "unit": s.unit,
-                    "unguided": baseline.as_ref().map(|(b, _)| b[i]),
+                    "unguided": baseline.as_ref().map(|(b, _, _)| b[i]),
                     "guided": guided[i],
+                    "plausibility": column(i),
                 })
             })
             .collect();
@@ -327,9 +373,11 @@ pub fn run(args: RunArgs) -> Result<()> {
             "solver": solver.name(),
             "seed": args.seed,
             "statements": statements,
-            "total": {"guided": total, "unguided": baseline.as_ref().map(|(b, _)| b.iter().sum::<f32>())},
-            "seconds": {"guided": result.seconds, "unguided": baseline.as_ref().map(|(_, s)| *s)},
-            "body": body_summary(people),
+            "total": {"guided": total, "unguided": baseline.as_ref().map(|(b, _, _)| b.iter().sum::<f32>())},
+            "seconds": {"guided": result.seconds, "unguided": baseline.as_ref().map(|(_, s, _)| *s)},
+            "body": body_summary(people, &envelope),
+            "plausibility": plausibility.to_json(),
+            "plausibility_unguided": unguided_plausibility.as_ref().map(|u| u.to_json()),
             "outputs": written,
         });
         let text = serde_json::to_string_pretty(&report).into_diagnostic()?;
@@ -337,5 +385,5 @@ pub fn run(args: RunArgs) -> Result<()> {
             .into_diagnostic()
             .wrap_err_with(|| format!("writing {}", path.display()))?;
     }
-    Ok(())
+    super::plausible::strict(&plausibility, args.strict)
 }

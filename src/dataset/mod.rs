@@ -6,6 +6,7 @@ pub mod build;
 pub mod captions;
 pub mod captions_cmu;
 pub mod captions_hdm05;
+pub mod envelope;
 pub mod labels;
 pub mod split;
 pub mod stats;

@@ -72,6 +72,32 @@ at 3s {
 always { separation(a, b, 0.4 m) }
 "#,
     ),
+    (
+        "Stand and draw a circle 30 cm across with the right hand in front of the chest, half a turn per second.",
+        r#"prompt "a person stands and moves the right hand in a circle"
+length 4s
+
+# `time` is the time since the start (s): `180 deg/s * time` turns half a circle a second.
+let centre = [-0.2, 1.2, 0.35]
+always {
+    dist(r_hand, centre + 0.15 * [cos(180 deg/s * time), sin(180 deg/s * time), 0]) < 5 cm
+}
+"#,
+    ),
+    (
+        "Raise both arms out to the sides from 1 s on, and end looking to the left.",
+        r#"prompt "a person raises both arms out to the sides and looks to the left"
+length 5s
+
+# `bodyLeft()` is the torso's own left: "out to the sides" wherever the body faces.
+during 1s..end + 1 {
+    dot(normalize(l_hand - l_shoulder), bodyLeft()) > 0.9
+    dot(normalize(r_hand - r_shoulder), bodyLeft()) < -0.9
+}
+# An end state, held over the last half second rather than on the last frame alone.
+during end - 0.5s..end + 1 { dot(gaze(), [1, 0, 0]) > 0.7 }
+"#,
+    ),
 ];
 
 /// Joint heights (m) of a real person standing upright: frame 110 of HumanML3D clip
@@ -240,7 +266,8 @@ with one complete program in a ```mprog code block, and nothing the language lac
   +X**, their right is −X. "Forward" is +Z, "backward" −Z, "to the left" +X. The solvers
   keep that start (only `latent` with `relax` may shift the whole motion), so a
   constraint on where the person is at frame 0 cannot be met: write places relative to
-  the start (`pelvis@start + [0, 0, 3]`) or make the start part of the region.
+  the start (`pelvis@start + [0, 0, 3]`), make the start part of the region, or place the
+  person (`start at [x, 0, z]`, below).
 - Only the pelvis's ground position and facing at frame 0 are fixed; the pose (arms,
   legs, height) at frame 0 is free.
 - Two people: `a` starts at the origin facing +Z, `b` at (0, 0, 2) facing −Z (2 m apart,
@@ -251,15 +278,23 @@ with one complete program in a ```mprog code block, and nothing the language lac
   line, 0.4–20 m) puts neighbours that far apart instead: with two people `b` then stands
   at (0, 0, 1), still facing `a` (−Z). Use it when people touch from the start (holding
   hands: about 1 m), else they must walk to each other first.
+- **Place people yourself** when the sentence says where they stand: `at [x, 0, z]` and/or
+  `facing [dx, 0, dz]` after a person's prompt, e.g. side by side facing +Z:
+  `people a "a person walks forward" at [-0.5, 0, 0] facing [0, 0, 1], b "a person walks
+  forward" at [0.5, 0, 0] facing [0, 0, 1]`. One person: a header line
+  `start at [1, 0, 2] facing [0, 0, -1]`. The solvers start each person there on frame 0
+  (a person with only `facing` keeps the default position, and the other way round);
+  starts are constant, on the floor, and at least 0.4 m apart. Never write a walk into
+  position that the sentence does not ask for.
 - The person is about 1.6 m tall: pelvis ≈ 0.92 m, head joint ≈ 1.48 m when standing
   (table below). Arms are about 0.6 m long (shoulder to wrist), legs about 0.85 m.
   Across the body: hips ±0.06–0.1 m from the pelvis in x, feet ±0.1–0.25 m (by stance),
   shoulders ±0.2 m.
 - Speeds: walking ≈ 1.3 m/s (0.07 m per frame), running ≈ 3 m/s (0.15 m per frame); a
   constraint on a thin region (a hurdle, a line) should be thicker than one frame's
-  travel, or a fast joint can step over it between frames. There is no `m/s` unit:
-  `vel(p)` (a vector) and `speed(p)` (a number) are in m/s, and a bare number compared
-  with them is in m/s too: `speed(pelvis) < 1.5` means 1.5 m/s.
+  travel, or a fast joint can step over it between frames. `vel(p)` (a vector) and
+  `speed(p)` (a number) are in m/s, and a bare number compared with them is in m/s too:
+  `speed(pelvis) < 1.5` means 1.5 m/s (or write the rate, `1.5 m/s`).
 
 ## The language in brief
 
@@ -282,9 +317,11 @@ minimize norm(acc(r_hand))             # any scalar
 
 - One statement per line (or `;`); a line continues after an operator, a comma or an
   open bracket. `#` comments.
-- Numbers take units `m cm mm s ms frames deg rad`; a bare number takes the unit of what
-  it meets (`head.y > 1.2` is metres). Vectors `[x, y, z]`; components `.x .y .z`;
-  `.xz` is the ground projection (y set to 0). Arithmetic `+ - * /` is unit-checked.
+- Numbers take units `m cm mm s ms frames deg rad`, and per second with `/s` written
+  without spaces (`1.5 m/s`, `180 deg/s`); a bare number takes the unit of what it meets
+  (`head.y > 1.2` is metres; so do `sin`/`cos`: `0.3 * cos(a)` next to metres is
+  metres). Vectors `[x, y, z]`; components `.x .y .z`; `.xz` is the ground projection
+  (y set to 0). Arithmetic `+ - * /` is unit-checked.
 - Vector parts may carry units (`[0, 60 cm, 0.5 m]`); bare parts take the unit of what
   the vector meets (metres next to a position). A unit after the bracket is an error.
 - `e@t` is `e` at frame t: `head@0`, `pelvis@start`, `pelvis@end`, `l_hand@2s`,
@@ -303,9 +340,21 @@ minimize norm(acc(r_hand))             # any scalar
 - `at` takes a list of times; `during` takes one range (write two blocks for two).
   `end - 2s`, `1.5s`, `-x`, and expressions inside vectors (`[0, 0, d]`) are all fine.
 - `a.pelvis@start` is `(a.pelvis)@start`; `f@start` works on a loop variable.
+- `time` is the time since the start in seconds, on every frame (a value, unlike the time
+  positions `start`/`end`): times an angular rate it is an angle, so a hand circling at
+  half a turn per second is
+  `always { dist(r_hand, [0.3*cos(180 deg/s * time), 1.2, 0.3*sin(180 deg/s * time)]) < 5 cm }`.
+  `time@2s` is 2 s.
+- The body's own axes follow the torso, wherever it faces or lies: `bodyLeft()`,
+  `bodyUp()` (pelvis to neck) and `bodyFront()`; arms out to the sides are
+  `dot(normalize(l_hand - l_shoulder), bodyLeft()) > 0.9` and
+  `dot(normalize(r_hand - r_shoulder), bodyLeft()) < -0.9`. `gaze()` is where the head
+  faces as far as joints show it (the shoulders' turn and the head's tip forward or back;
+  the head turning on its own neck is not seen): looking left is `dot(gaze(), [1, 0, 0]) > 0.7`.
+- A function sees its arguments, the `param`s, and the `let`s written above it.
 - Reserved, not usable as names: `prompt length spacing param def let always at during for in if
-  else weight minimize maximize and or not x y z xz me joints people start mid end true
-  false`.
+  else weight minimize maximize and or not x y z xz me joints people start mid end time
+  true false`.
 - Functions may take people: `def hold(p, q) = dist(p.r_hand, q.l_hand) < 10 cm`;
   `for p in people { … }` loops over every person and `for j in [head, neck]`,
   `for h in hands` or `for j in joints` (all 22) over joints. With several people a joint
@@ -366,7 +415,10 @@ const RULES: &str = r#"
 5. Keyframes must lie inside the length: with `length 4s`, `at 5s` is an error; prefer
    `start`, `mid`, `end` and percentages.
 6. Give a `length` (at most 9.8 s) and a `prompt` that describes the whole motion; the
-   constraints only steer it.
+   constraints only steer it. An end state ("ends lying down", "ends crouched") is held
+   over the last half second, `during end - 0.5s..end + 1 { … }`: an `at end` block that
+   fixes the posture on the last frame alone makes the body snap into it
+   (`mprog::keyframe_pose`).
 7. Prefer tolerances to exact equalities for positions (`dist(p, q) < 5 cm`), and keep
    targets reachable: arms are about 0.6 m long, a step is about 0.7 m, walking speed is
    about 1.3 m/s. A hand target farther than that from where the person stands needs a
@@ -413,6 +465,11 @@ mod tests {
             "length 2s\npeople a \"x\", b \"y\"\nfor p in people { for j in joints { p.j.y > -5 cm } }\n",
             "length 2s\nspeed(pelvis) < 1.5\nalways { balanced(me) }\nat end { dot(facing(), [0, 0, 1]) > 0.9 }\n",
             "length 2s\nat end { signedDistToPlane(r_hand, [0, 0, 1], [0, 0, -1]) > 0 and signedDistToPlane(r_hand, [0, 0, 1], [0, 0, -1]) < 8 cm }\n",
+            // The inline snippets on `time`, the body's axes, `gaze` and end states.
+            "length 4s\nalways { dist(r_hand, [0.3*cos(180 deg/s * time), 1.2, 0.3*sin(180 deg/s * time)]) < 5 cm }\n",
+            "length 4s\nalways { dot(normalize(l_hand - l_shoulder), bodyLeft()) > 0.9\n dot(normalize(r_hand - r_shoulder), bodyLeft()) < -0.9 }\n",
+            "length 4s\nat end { dot(gaze(), [1, 0, 0]) > 0.7 }\nat 1s { head.y < 1.2 m + 0.1 m/s * time@2s }\n",
+            "length 4s\nduring end - 0.5s..end + 1 { pelvis.y < 0.5 m }\nalways { speed(pelvis) < 1.5 m/s }\n",
         ] {
             let d = crate::lang::check_source(src, "t.mprog", &[]);
             assert!(!d.has_errors(), "{src}\n{}", d.render_plain());
@@ -426,6 +483,18 @@ mod tests {
         .unwrap();
         let b = p.placements()[1];
         assert!((b.x.abs(), (b.z - 1.0).abs()) < (1e-6, 1e-6), "{b:?}");
+        // The card's side-by-side placement: both face +Z, 1 m apart.
+        let p = crate::lang::compile(
+            "length 2s\npeople a \"a person walks forward\" at [-0.5, 0, 0] facing [0, 0, 1], b \"a person walks forward\" at [0.5, 0, 0] facing [0, 0, 1]\nalways { separation(a, b, 0.5 m) }\n",
+            "t.mprog",
+            &[],
+        )
+        .unwrap();
+        let [a, b] = [p.placements()[0], p.placements()[1]];
+        assert_eq!(
+            (a.x, a.z, a.yaw, b.x, b.z, b.yaw),
+            (-0.5, 0.0, 0.0, 0.5, 0.0, 0.0)
+        );
     }
 
     #[test]

@@ -14,6 +14,9 @@ pub const BAD_NUMBER: &str = "mprog::bad_number";
 pub const BAD_OVERRIDE: &str = "mprog::bad_override";
 /// A `spacing` outside 0.4–20 m.
 pub const BAD_SPACING: &str = "mprog::bad_spacing";
+/// A start placement (`at [x, 0, z]`, `facing [dx, 0, dz]`) that is not a constant point on
+/// the floor or horizontal direction, or that puts two people inside each other.
+pub const BAD_START: &str = "mprog::bad_start";
 /// A negative or non-constant `weight`.
 pub const BAD_WEIGHT: &str = "mprog::bad_weight";
 /// `a < b < c`: write two constraints.
@@ -28,10 +31,15 @@ pub const EMPTY_FUNCTION: &str = "mprog::empty_function";
 pub const EMPTY_PROGRAM: &str = "mprog::empty_program";
 /// `=` between measured values, almost never exactly true: use `dist(…) < tolerance`.
 pub const EXACT_EQUALITY: &str = "mprog::exact_equality";
-/// A prompt far from every caption the model was trained on (warning; needs a sentence-encoder model).
+/// A prompt the model does not read as written: far from every caption it was trained on, or
+/// read through its nearest captions (warning; needs a sentence-encoder model).
 pub const FAR_PROMPT: &str = "mprog::far_prompt";
 /// Two places for one joint that it can only travel between faster than 4 m/s (warning).
 pub const FRAME_JUMP: &str = "mprog::frame_jump";
+/// A single-frame `at` on the last 0.25 s (`at end`) that fixes the body's posture: the
+/// absolute height of the pelvis, spine, neck, head or centre of mass, or of two or more
+/// joints other than the feet (warning; hold the end state over a `during` window).
+pub const KEYFRAME_POSE: &str = "mprog::keyframe_pose";
 /// A `length` longer than the model's 9.8 s.
 pub const LONG_MOTION: &str = "mprog::long_motion";
 /// `%` outside a time position.
@@ -110,6 +118,10 @@ pub const ALL: &[(&str, &str)] = &[
         "a `--set` value that cannot replace the parameter (a vector, a unit clash)",
     ),
     (BAD_SPACING, "a `spacing` outside 0.4–20 m"),
+    (
+        BAD_START,
+        "a start placement (`at [x, 0, z]`, `facing [dx, 0, dz]`) that is not a constant point on the floor or horizontal direction, or that puts two people inside each other",
+    ),
     (BAD_WEIGHT, "a negative or non-constant `weight`"),
     (CHAINED_COMPARISON, "`a < b < c`: write two constraints"),
     (DIVISION_BY_ZERO, "division by a constant zero"),
@@ -125,11 +137,15 @@ pub const ALL: &[(&str, &str)] = &[
     ),
     (
         FAR_PROMPT,
-        "a prompt far from every caption the model was trained on (warning; needs a sentence-encoder model)",
+        "a prompt the model does not read as written: far from every caption it was trained on, or read through its nearest captions (warning; needs a sentence-encoder model)",
     ),
     (
         FRAME_JUMP,
         "two places for one joint that it can only travel between faster than 4 m/s (warning)",
+    ),
+    (
+        KEYFRAME_POSE,
+        "a single-frame `at` on the last 0.25 s (`at end`) that fixes the body's posture: the absolute height of the pelvis, spine, neck, head or centre of mass, or of two or more joints other than the feet, which the motion would snap into on its last frame (warning; hold the end state over a `during` window)",
     ),
     (LONG_MOTION, "a `length` longer than the model's 9.8 s"),
     (MISPLACED_PERCENT, "`%` outside a time position"),

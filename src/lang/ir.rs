@@ -119,6 +119,9 @@ pub enum Op {
         persons: Vec<usize>,
         weights: Vec<f32>,
     },
+    /// Seconds since the start (`time`) at each frame of the domain `[1, |D|, 1, 1]`:
+    /// frame index / fps, a constant of the frame (no gradient, the same for every sample).
+    Time { domain: DomainId },
     /// Channel `axis` of a vector.
     Component { arg: NodeId, axis: usize },
     /// Three scalars stacked into a vector.
@@ -147,7 +150,7 @@ impl Op {
     /// The nodes this op reads.
     pub fn args(&self) -> Vec<NodeId> {
         match self {
-            Op::Const(_) | Op::Gather { .. } | Op::MassCenter { .. } => vec![],
+            Op::Const(_) | Op::Gather { .. } | Op::MassCenter { .. } | Op::Time { .. } => vec![],
             Op::Component { arg, .. } | Op::Unary { arg, .. } => vec![*arg],
             Op::SumChannels(a) | Op::Norm(a) | Op::Relabel(a) => vec![*a],
             Op::Compose(a) => a.to_vec(),
@@ -159,7 +162,7 @@ impl Op {
     /// Remaps the nodes this op reads.
     pub fn map_args(&mut self, f: impl Fn(NodeId) -> NodeId) {
         match self {
-            Op::Const(_) | Op::Gather { .. } | Op::MassCenter { .. } => {}
+            Op::Const(_) | Op::Gather { .. } | Op::MassCenter { .. } | Op::Time { .. } => {}
             Op::Component { arg, .. } | Op::Unary { arg, .. } => *arg = f(*arg),
             Op::SumChannels(a) | Op::Norm(a) | Op::Relabel(a) => *a = f(*a),
             Op::Compose(a) => a.iter_mut().for_each(|x| *x = f(*x)),
@@ -234,6 +237,19 @@ pub struct Ir {
     /// Declared spacing of the people's start placements in metres (`None`: the default).
     #[serde(default)]
     pub spacing: Option<f64>,
+    /// Declared starts (`at`/`facing`), one per person (or empty): they override the
+    /// default placement's position, its facing, or both.
+    #[serde(default)]
+    pub starts: Vec<StartOverride>,
+}
+
+/// A person's declared start: where they stand on frame 0 and which way they face.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StartOverride {
+    /// Ground position `(x, z)` in metres.
+    pub at: Option<[f64; 2]>,
+    /// Facing as a yaw about +Y in radians (`(sin yaw, 0, cos yaw)`; 0 faces +Z).
+    pub yaw: Option<f64>,
 }
 
 /// What evaluating a program costs, estimated at the declared length.
@@ -259,12 +275,22 @@ impl CostEstimate {
 
 impl Ir {
     /// Where each person starts: the default placements, `spacing` metres apart when the
-    /// program declares one.
+    /// program declares one, with each declared `at`/`facing` put in.
     pub fn start_placements(&self) -> Vec<crate::scene::Placement> {
         let spacing = self
             .spacing
             .map_or(crate::scene::DEFAULT_SPACING, |s| s as f32);
-        crate::scene::Placement::defaults(self.people, spacing)
+        let mut places = crate::scene::Placement::defaults(self.people, spacing);
+        for (place, start) in places.iter_mut().zip(&self.starts) {
+            if let Some([x, z]) = start.at {
+                place.x = x as f32;
+                place.z = z as f32;
+            }
+            if let Some(yaw) = start.yaw {
+                place.yaw = yaw as f32;
+            }
+        }
+        places
     }
 
     /// Frame indices of a domain for a motion of `f` frames.

@@ -80,35 +80,33 @@ pub fn prompts_of(source: &str) -> Vec<(String, syntax::ast::Span)> {
     out
 }
 
-/// The caption a model knows that lies nearest a prompt, and their cosine similarity.
-pub type NearestCaption = dyn Fn(&str) -> Option<(String, f32)> + Send + Sync;
+/// What the motion model says of a prompt before generating from it: the lines `mprog run`
+/// and `mprog gen` print (far from every training caption, read through its nearest
+/// captions, …); empty when it reads the prompt as written. The language itself knows no
+/// model: the CLI and the MCP server pass the model's.
+pub type PromptReport = dyn Fn(&str) -> Vec<String> + Send + Sync;
 
-/// `diags` with an `mprog::far_prompt` warning on every prompt of `source` whose nearest
-/// training caption (`nearest`, from the motion model's sentence encoder; the language
-/// itself knows no model) has a cosine below `far`.
-pub fn with_far_prompts(
-    diags: Diagnostics,
-    source: &str,
-    nearest: &NearestCaption,
-    far: f32,
-) -> Diagnostics {
+/// `diags` with an `mprog::far_prompt` warning on every prompt of `source` the model has
+/// something to say about (`report`), so `check` warns of every prompt `run` would.
+pub fn with_far_prompts(diags: Diagnostics, source: &str, report: &PromptReport) -> Diagnostics {
     let mut items = diags.items;
     for (prompt, span) in prompts_of(source) {
-        if let Some((caption, cosine)) = nearest(&prompt)
-            && cosine < far
-        {
-            items.push(
-                Diagnostic::warning(
-                    codes::FAR_PROMPT,
-                    span,
-                    format!("the motion model was never trained on anything like \"{prompt}\""),
-                )
-                .label("far from every training caption")
-                .help(format!(
-                    "the prompt is far from every caption the model was trained on (cosine {cosine:.2} < {far}); nearest known: \"{caption}\"; the motion will follow the constraints more than the words. `mprog prompt` lists the actions the model knows"
-                )),
-            );
+        let lines = report(&prompt);
+        if lines.is_empty() {
+            continue;
         }
+        items.push(
+            Diagnostic::warning(
+                codes::FAR_PROMPT,
+                span,
+                format!("the motion model has no training caption like \"{prompt}\""),
+            )
+            .label("not a caption the model knows")
+            .help(format!(
+                "{}; the motion will follow the constraints more than the words. `mprog prompt` lists the actions the model knows",
+                lines.join("; ")
+            )),
+        );
     }
     Diagnostics::new(&diags.name, diags.source, items)
 }

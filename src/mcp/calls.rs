@@ -13,11 +13,11 @@ pub const SOURCE_NAME: &str = "program.mprog";
 pub fn check(
     source: &str,
     set: &[(String, f64)],
-    far_prompts: Option<(&crate::lang::NearestCaption, f32)>,
+    far_prompts: Option<&crate::lang::PromptReport>,
 ) -> Value {
     let mut diags = crate::lang::check_source(source, SOURCE_NAME, set);
-    if let Some((nearest, far)) = far_prompts {
-        diags = crate::lang::with_far_prompts(diags, source, nearest, far);
+    if let Some(report) = far_prompts {
+        diags = crate::lang::with_far_prompts(diags, source, report);
     }
     json!({
         "file": SOURCE_NAME,
@@ -161,14 +161,18 @@ mod tests {
 
     #[test]
     fn check_warns_on_a_prompt_far_from_the_models_captions() {
-        let nearest = |prompt: &str| -> Option<(String, f32)> {
-            let cosine = if prompt.contains("violin") { 0.31 } else { 0.8 };
-            Some(("a person waves".to_string(), cosine))
+        // What the model says of a prompt: the lines `run` would print before generating.
+        let report = |prompt: &str| -> Vec<String> {
+            if prompt.contains("violin") {
+                vec!["the prompt is far from every caption the model was trained on (cosine 0.31 < 0.5); nearest known: \"a person waves\"".to_string()]
+            } else {
+                Vec::new()
+            }
         };
         let far = check(
             "prompt \"a person plays the violin\"\nlength 2s\nat end { head.y > 1 m }\n",
             &[],
-            Some((&nearest, 0.5)),
+            Some(&report),
         );
         let d = &far["diagnostics"][0];
         assert_eq!(d["code"], crate::lang::codes::FAR_PROMPT);
@@ -183,8 +187,14 @@ mod tests {
         let near = check(
             "prompt \"a person walks\"\nlength 2s\nat end { head.y > 1 m }\n",
             &[],
-            Some((&nearest, 0.5)),
+            Some(&report),
         );
-        assert_eq!(near["diagnostics"].as_array().unwrap().len(), 0);
+        let far_prompts = near["diagnostics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|d| d["code"] == crate::lang::codes::FAR_PROMPT)
+            .count();
+        assert_eq!(far_prompts, 0, "{near}");
     }
 }

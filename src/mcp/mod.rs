@@ -40,9 +40,9 @@ pub struct Config {
     /// The prompt card served as the MCP prompt and resource (None: the card without the
     /// model's action list); the CLI passes the one for the model runs use.
     pub card: Option<String>,
-    /// The nearest training caption of a prompt, with the cosine below which `check`
-    /// warns `mprog::far_prompt` (a sentence-encoder model's; the CLI passes it).
-    pub far_prompts: Option<(Arc<crate::lang::NearestCaption>, f32)>,
+    /// What the model says of a prompt, for `check`'s `mprog::far_prompt` warnings (a
+    /// sentence-encoder model's; the CLI passes it).
+    pub far_prompts: Option<Arc<crate::lang::PromptReport>>,
 }
 
 impl std::fmt::Debug for Config {
@@ -53,10 +53,7 @@ impl std::fmt::Debug for Config {
             .field("model", &self.model)
             .field("time_limit", &self.time_limit)
             .field("card", &self.card.as_ref().map(String::len))
-            .field(
-                "far_prompts",
-                &self.far_prompts.as_ref().map(|(_, far)| far),
-            )
+            .field("far_prompts", &self.far_prompts.is_some())
             .finish()
     }
 }

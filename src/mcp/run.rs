@@ -191,7 +191,7 @@ mod tests {
             &exe,
             format!(
                 "#!/bin/sh\necho start >> {log}\nsleep {seconds}\necho end >> {log}\n\
-                 while [ $# -gt 0 ]; do if [ \"$1\" = --report ]; then echo '{{\"outputs\": []}}' > \"$2\"; fi; shift; done\n",
+                 while [ $# -gt 0 ]; do if [ \"$1\" = --report ]; then echo '{{\"outputs\": [], \"plausibility\": {{\"ok\": false, \"problems\": []}}}}' > \"$2\"; fi; shift; done\n",
                 log = log.display()
             ),
         )
@@ -233,6 +233,8 @@ mod tests {
             )
         });
         assert!(a.is_ok() && b.is_ok());
+        // The run's plausibility report reaches the tool's result as it is.
+        assert_eq!(a.ok().unwrap().report["plausibility"]["ok"], false);
         let log = std::fs::read_to_string(dir.path().join("log")).unwrap();
         assert_eq!(log, "start\nend\nstart\nend\n", "runs overlapped");
     }

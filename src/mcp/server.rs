@@ -28,7 +28,7 @@ pub struct Server {
     /// The prompt card (with the model's actions when the CLI knows them).
     pub(super) card: Arc<String>,
     /// Far-prompt warnings for `check` (see [`super::Config::far_prompts`]).
-    pub(super) far_prompts: Option<(Arc<crate::lang::NearestCaption>, f32)>,
+    pub(super) far_prompts: Option<Arc<crate::lang::PromptReport>>,
 }
 
 fn text_result(v: &Value, error: bool) -> CallToolResult {
@@ -56,7 +56,7 @@ impl Server {
             "check" => {
                 let source = args::source(&a).map_err(bad)?;
                 let set = args::settings(&a, "set").map_err(bad)?;
-                let far = self.far_prompts.as_ref().map(|(n, c)| (n.as_ref(), *c));
+                let far = self.far_prompts.as_deref();
                 text_result(&calls::check(&source, &set, far), false)
             }
             "score" => {

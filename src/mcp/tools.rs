@@ -46,8 +46,12 @@ pub fn tools() -> Vec<Tool> {
         Tool::new(
             "run",
             "Generate a motion with the model, steered by the program. Returns each statement's \
-             error next to the unguided sample's, the files written (relative to the output \
-             folder) and a PNG strip of the motion. Runs are one at a time and stopped at the \
+             error next to the unguided sample's and whether it was met plausibly (\"met\", \
+             \"met by a snap at 5.85–5.95 s\", \"not met\"), the plausibility report \
+             (`plausibility`: ok, and each problem with its person, kind, body part, frames, \
+             seconds, value, limit, what the limit is measured against and the statements \
+             active there: repair those), the files written (relative to the output folder) \
+             and a PNG strip of the motion. Runs are one at a time and stopped at the \
              server's time limit; for a quick look pass knobs such as {\"steps\": 10}.",
             schema(json!({"type": "object", "required": ["source"],
                 "properties": {

@@ -4,6 +4,7 @@
 //! | part | module | what |
 //! | --- | --- | --- |
 //! | per-motion metrics | [`per_motion`] | foot skating, max acceleration, bone-length variation, floor penetration, speed, turn, wrists above head |
+//! | plausibility | [`plausibility`] | every output held against an envelope measured on real clips: snaps, speed, floor, skating, people overlapping, rigid parts, facing; located in time |
 //! | linear algebra | [`linalg`] | Jacobi eigen-decomposition, PSD square root (f64) |
 //! | set scores | [`scores`] | FID, diversity, R-precision on embeddings |
 //! | evaluator | [`encoder`], [`evaluator`], [`train_encoder`], [`card`] | contrastive motion/caption encoders, their files, their training |
@@ -16,6 +17,7 @@ pub mod error;
 pub mod evaluator;
 pub mod linalg;
 pub mod per_motion;
+pub mod plausibility;
 pub mod report;
 pub mod scores;
 pub mod table;

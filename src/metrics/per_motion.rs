@@ -63,6 +63,17 @@ pub fn foot_skating_ratio(m: &Motion) -> f32 {
     if t < 2 {
         return 0.0;
     }
+    let skating = skating_steps(m);
+    skating.iter().filter(|&&s| s).count() as f32 / (t - 1) as f32
+}
+
+/// For each of the `T − 1` frame steps, whether a foot in floor contact slides there (the
+/// steps [`foot_skating_ratio`] counts); empty for motions shorter than two frames.
+pub fn skating_steps(m: &Motion) -> Vec<bool> {
+    let t = m.len();
+    if t < 2 {
+        return Vec::new();
+    }
     let fps = m.fps;
     let mut skating = vec![false; t - 1];
     for &foot in &SKATING_FEET {
@@ -81,7 +92,7 @@ pub fn foot_skating_ratio(m: &Motion) -> f32 {
             *s |= contact && speed[i] > SKATING_SPEED && avg[i] > SKATING_SPEED;
         }
     }
-    skating.iter().filter(|&&s| s).count() as f32 / (t - 1) as f32
+    skating
 }
 
 /// Largest second difference of any joint position (m/frame², no fps scaling).

@@ -8,6 +8,8 @@
 //! <dir>/captions.safetensors  training captions, embedded (sentence-encoder models)
 //! <dir>/actions.json       what the training clips show, with clip counts (optional)
 //! <dir>/lengths.json       median clip length per training caption (optional)
+//! <dir>/envelope.json      how the training clips move, for plausibility reports
+//!                          (optional; `mprog data envelope` measures it)
 //! <dir>/mean.npy, std.npy  [263] normalisation statistics
 //! <dir>/model.safetensors  denoiser weights
 //! ```
@@ -395,6 +397,33 @@ pub fn shipped_actions() -> Vec<(String, usize)> {
         .collect()
 }
 
+/// `<dir>/envelope.json`, the plausibility envelope measured on the bundle's training
+/// data; `None` when the bundle has none (reports then use [`Envelope::builtin`], the
+/// one this binary was built with, and say so).
+///
+/// [`Envelope::builtin`]: crate::dataset::envelope::Envelope::builtin
+pub fn bundle_envelope(
+    dir: &Path,
+) -> Result<Option<crate::dataset::envelope::Envelope>, WeightsError> {
+    let p = dir.join("envelope.json");
+    if !p.exists() {
+        return Ok(None);
+    }
+    crate::dataset::envelope::Envelope::load(&p)
+        .map(Some)
+        .map_err(|e| mismatch(&p, e.to_string()))
+}
+
+/// The envelope outputs of the bundle in `dir` are checked against: its own, else the
+/// built-in one (with a note in its `source`).
+pub fn envelope_or_builtin(dir: &Path) -> Result<crate::dataset::envelope::Envelope, WeightsError> {
+    Ok(bundle_envelope(dir)?.unwrap_or_else(|| {
+        let mut env = crate::dataset::envelope::Envelope::builtin();
+        env.source = format!("{} (the model has no envelope.json)", env.source);
+        env
+    }))
+}
+
 /// Writes `<dir>/actions.json`.
 pub fn save_trained_actions(dir: &Path, actions: &[TrainedAction]) -> Result<(), WeightsError> {
     let p = dir.join("actions.json");
@@ -413,4 +442,24 @@ pub fn default_model_dir() -> PathBuf {
         return local;
     }
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/default")
+}
+
+#[cfg(test)]
+mod envelope_tests {
+    use super::*;
+
+    #[test]
+    fn a_bundle_without_an_envelope_falls_back_to_the_builtin_one() {
+        let dir = tempfile::tempdir().unwrap();
+        assert!(bundle_envelope(dir.path()).unwrap().is_none());
+        let env = envelope_or_builtin(dir.path()).unwrap();
+        assert!(env.source.starts_with("built in: "), "{}", env.source);
+        assert!(env.source.ends_with("(the model has no envelope.json)"));
+        let mut own = crate::dataset::envelope::Envelope::builtin();
+        own.source = "own".into();
+        own.save(&dir.path().join("envelope.json")).unwrap();
+        assert_eq!(envelope_or_builtin(dir.path()).unwrap().source, "own");
+        std::fs::write(dir.path().join("envelope.json"), "{}").unwrap();
+        assert!(bundle_envelope(dir.path()).is_err());
+    }
 }

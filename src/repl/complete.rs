@@ -13,7 +13,7 @@ use crate::skeleton::all_joint_names;
 pub const KEYWORDS: &[&str] = &[
     "prompt", "length", "spacing", "param", "people", "def", "let", "always", "at", "during",
     "for", "in", "if", "else", "weight", "minimize", "maximize", "and", "or", "not", "start",
-    "mid", "end", "joints", "me",
+    "mid", "end", "time", "joints", "me",
 ];
 
 /// Commands whose argument is a file name.

@@ -298,6 +298,7 @@ impl Session {
                     format!("gen \"{prompt}\" {seconds}s seed {seed}"),
                 );
                 let mut r = Reply::text(self.describe_motion());
+                r.push(self.plausibility(&[Some(prompt.to_string())]));
                 if !unknown.is_empty() {
                     r.push(Item::Warning(format!(
                         "the model does not know: {}",
@@ -338,6 +339,7 @@ impl Session {
         let Some(prompts) = program.prompts().into_iter().collect::<Option<Vec<_>>>() else {
             return Reply::error("every person needs a prompt: add `prompt \"…\"` to the program");
         };
+        let prompt_list: Vec<Option<String>> = prompts.iter().cloned().map(Some).collect();
         let edit = match (&self.take, strength) {
             (None, Some(_)) => {
                 return Reply::error("`strength` edits a take: load one with `:motion FILE` first");
@@ -392,8 +394,31 @@ impl Session {
                 for item in probe::score(self).items {
                     reply.push(item);
                 }
+                reply.push(self.plausibility(&prompt_list));
                 reply
             }
+        }
+    }
+
+    /// The plausibility report of the current motion (`mprog run` prints the same, with the
+    /// statements active at each problem), against the bundle's envelope.
+    fn plausibility(&self, prompts: &[Option<String>]) -> Item {
+        let Some(m) = &self.motion else {
+            return Item::Text(String::new());
+        };
+        let env = match self.model_dir.as_deref() {
+            Some(dir) => match crate::model::weights::envelope_or_builtin(dir) {
+                Ok(env) => env,
+                Err(e) => return Item::Warning(format!("no plausibility report: {e}")),
+            },
+            None => crate::dataset::envelope::Envelope::builtin(),
+        };
+        let report = crate::metrics::plausibility::check(&m.people, prompts, &env);
+        let text = report.lines().join("\n");
+        if report.ok {
+            Item::Text(text)
+        } else {
+            Item::Warning(text)
         }
     }
 

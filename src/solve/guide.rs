@@ -72,6 +72,9 @@ pub(crate) const ROOT_COLUMNS: usize = 4;
 /// (unguided 0.122; book, solvers chapter).
 pub const ACCEL_HOLD: f32 = 0.25;
 
+/// Default weight of the envelope penalty ([`FusedSettings::envelope`], [`super::envelope`]).
+pub const ENVELOPE: f32 = 1.0;
+
 /// Iterations of each late step the acceleration hold acts over: the bench's whole late
 /// step. It shapes the edit while the program is being met; a program still unmet after
 /// them is pushed on without it. Held over all of the CLI's 500, an unmet program (HSI-2
@@ -147,6 +150,10 @@ pub struct FusedSettings {
     /// Weight of the penalty on the joint acceleration the last `late_steps` steps add
     /// ([`super::accel`]); 0 turns it off.
     pub accel_hold: f32,
+    /// Weight of the penalty on leaving the training data's envelope (joints below the
+    /// floor, accelerations beyond the largest recorded) over every iteration of the last
+    /// `late_steps` steps ([`super::envelope`]); 0 turns it off.
+    pub envelope: f32,
     /// Before the last `late_steps` steps, step only the root columns (yaw velocity, XZ
     /// velocity, height): the path is steered while the denoiser keeps the pose its own
     /// (see the module notes).
@@ -169,6 +176,7 @@ impl FusedSettings {
         keep_skeleton: false,
         foot_lock: 0.0,
         accel_hold: 0.0,
+        envelope: 0.0,
         early_root_only: false,
         split_terms: false,
         late_root_scale: 1.0,
@@ -178,6 +186,11 @@ impl FusedSettings {
         if !(self.accel_hold.is_finite() && self.accel_hold >= 0.0) {
             return Err(SolveError::Invalid(
                 "guide: the acceleration hold's weight must be finite and ≥ 0".into(),
+            ));
+        }
+        if !(self.envelope.is_finite() && self.envelope >= 0.0) {
+            return Err(SolveError::Invalid(
+                "guide: the envelope penalty's weight must be finite and ≥ 0".into(),
             ));
         }
         if !(self.foot_lock.is_finite() && self.foot_lock >= 0.0) {
@@ -200,6 +213,7 @@ impl Default for FusedSettings {
             keep_skeleton: true,
             foot_lock: 1.0,
             accel_hold: ACCEL_HOLD,
+            envelope: ENVELOPE,
             early_root_only: true,
             split_terms: true,
             late_root_scale: 0.01,
@@ -380,6 +394,8 @@ struct Inner {
     foot_lock: f32,
     /// The acceleration hold's weight (0: without).
     accel_hold: f32,
+    /// The envelope penalty's weight (0: without).
+    envelope: f32,
     /// Columns of a head row that move: the root's, or all of them.
     moving: usize,
     /// A Polyak step per term.
@@ -399,6 +415,7 @@ impl Inner {
             skeleton: fused.keep_skeleton && late,
             foot_lock: if late { fused.foot_lock } else { 0.0 },
             accel_hold: if late { fused.accel_hold } else { 0.0 },
+            envelope: if late { fused.envelope } else { 0.0 },
             moving: if fused.early_root_only && !late {
                 ROOT_COLUMNS
             } else {
@@ -426,6 +443,7 @@ fn guide_fused(
         skeleton,
         foot_lock,
         accel_hold,
+        envelope,
         moving,
         split,
         root_scale,
@@ -446,6 +464,7 @@ fn guide_fused(
     if accel_hold > 0.0 {
         objective.hold_accel(&head, accel_hold);
     }
+    objective.keep_in_envelope(envelope);
     let mut terms = TermGradients::default();
     let mut combined = vec![0.0; head.len()];
     let mut total = Vec::new();
@@ -741,6 +760,7 @@ impl SolverConfig for GuideConfig {
         knob!(Real, "smooth", "σ in frames of the Gaussian each late step's gradient is smoothed with over time; 0: OmniControl's raw gradient", smooth_frames),
         fused_knob!(Real, "feet", "weight of the slide penalty on planted toes in the last `late_steps`; 0: off", foot_lock),
         fused_knob!(Real, "accel", "weight of the penalty on the joint acceleration the last `late_steps` add (jerks where keyframes are scattered); 0: off", accel_hold),
+        fused_knob!(Real, "envelope", "weight of the penalty on joints below the floor and accelerations beyond the training data's largest, over all of the last `late_steps`; 0: off", envelope),
         fused_knob!(
             Flag("every column", "root columns only before the late steps"),
             "early_root",

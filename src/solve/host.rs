@@ -19,6 +19,7 @@ use super::accel::AccelHold;
 use super::bones::SkeletonProjection;
 use super::decode::Decoder;
 use super::driver::host;
+use super::envelope::EnvelopeGuard;
 use super::feet::FootLock;
 use super::{MotionError, SolveError};
 use crate::features::layout::RIC;
@@ -155,6 +156,8 @@ pub struct HostObjective<'a> {
     feet: Option<FootLock>,
     /// Penalty on added acceleration ([`Self::hold_accel`]).
     accel: Option<AccelHold>,
+    /// Penalty on leaving the real envelope ([`Self::keep_in_envelope`]).
+    envelope: Option<EnvelopeGuard>,
     /// The two penalties per sample at the last evaluation (zeros without them).
     penalty: Vec<f32>,
     /// Rigid XZ transform per motion `[B·P]`, applied in the person's frame before its
@@ -191,6 +194,7 @@ impl<'a> HostObjective<'a> {
             projection: None,
             feet: None,
             accel: None,
+            envelope: None,
             penalty: vec![0.0; batch],
             rigid: None,
             local: Vec::new(),
@@ -251,6 +255,14 @@ impl<'a> HostObjective<'a> {
         self.accel = Some(AccelHold::new(&reference, self.frames, people, weight));
     }
 
+    /// From now on add [`EnvelopeGuard`]'s penalty (weight `weight`; 0 removes it) on
+    /// joints below the floor and accelerations beyond the training data's to what
+    /// [`eval`](Self::eval) differentiates.
+    pub fn keep_in_envelope(&mut self, weight: f32) {
+        let people = self.placements.len();
+        self.envelope = (weight > 0.0).then(|| EnvelopeGuard::new(self.frames, people, weight));
+    }
+
     /// Stop adding the acceleration hold's penalty.
     pub fn release_accel(&mut self) {
         self.accel = None;
@@ -259,10 +271,11 @@ impl<'a> HostObjective<'a> {
         }
     }
 
-    /// Stop adding the foot and acceleration penalties.
+    /// Stop adding the foot, acceleration and envelope penalties.
     pub fn unlock_feet(&mut self) {
         self.feet = None;
         self.accel = None;
+        self.envelope = None;
         self.penalty.fill(0.0);
     }
 
@@ -275,7 +288,7 @@ impl<'a> HostObjective<'a> {
 
     /// Whether a penalty is set.
     fn penalized(&self) -> bool {
-        self.feet.is_some() || self.accel.is_some()
+        self.feet.is_some() || self.accel.is_some() || self.envelope.is_some()
     }
 
     /// The penalties of the current joints per sample; their gradient added to `g`.
@@ -284,6 +297,9 @@ impl<'a> HostObjective<'a> {
         for p in [
             self.feet.as_ref().map(|lock| lock.eval(&self.joints, g)),
             self.accel.as_ref().map(|hold| hold.eval(&self.joints, g)),
+            self.envelope
+                .as_ref()
+                .map(|guard| guard.eval(&self.joints, g)),
         ]
         .into_iter()
         .flatten()

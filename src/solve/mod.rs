@@ -56,6 +56,7 @@ pub mod cleanup;
 mod decode;
 mod driver;
 pub mod edit;
+pub mod envelope;
 pub mod feet;
 pub mod host;
 pub mod knobs;

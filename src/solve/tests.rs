@@ -656,6 +656,7 @@ fn fused_and_graph_guidance_agree() {
             keep_skeleton: false,
             foot_lock: 0.0,
             accel_hold: 0.0,
+            envelope: 0.0,
             early_root_only: false,
             split_terms: false,
             ..FusedSettings::default()
@@ -1049,6 +1050,8 @@ fn the_acceleration_hold_spreads_a_keyframe_edit_over_its_neighbours() {
             smooth_frames: 0.0,
             fused: Some(FusedSettings {
                 accel_hold,
+                // The envelope bounds the untrained bundle's own jumps: off, to see the hold.
+                envelope: 0.0,
                 ..FusedSettings::default()
             }),
             ..GuideConfig::default()
@@ -1065,6 +1068,9 @@ fn the_acceleration_hold_spreads_a_keyframe_edit_over_its_neighbours() {
     let mut knob = guide(0.0);
     knob.set_knob("accel", -1.0).unwrap();
     assert_refused(&bundle, knob, "acceleration hold");
+    let mut knob = guide(0.0);
+    knob.set_knob("envelope", -1.0).unwrap();
+    assert_refused(&bundle, knob, "envelope");
 }
 
 /// An error that every motion meets.
@@ -1094,6 +1100,7 @@ fn where_the_program_is_met_the_hold_only_takes_back_the_projections_jerk() {
                 accel_hold,
                 keep_skeleton,
                 foot_lock: 0.0,
+                envelope: 0.0,
                 ..FusedSettings::default()
             }),
             ..GuideConfig::default()
@@ -1364,6 +1371,8 @@ fn late_root_scale_leaves_the_path_and_moves_the_pose() {
             k_late: 30,
             fused: Some(FusedSettings {
                 late_root_scale,
+                // The envelope's floor moves the root of the untrained bundle's motions.
+                envelope: 0.0,
                 ..FusedSettings::default()
             }),
             ..GuideConfig::default()

@@ -52,6 +52,9 @@ pub struct RunRow {
     pub max_accel: f32,
     /// Mean of the per-motion largest bone-length error against the skeleton (m).
     pub bone_error: f32,
+    /// Share of samples whose plausibility report (`metrics::plausibility`, against the
+    /// built-in envelope) finds no problem.
+    pub plausible: f32,
     /// Wall seconds per sample.
     pub seconds_per_sample: f64,
     /// Why the run failed (then the numbers are zero).
@@ -76,6 +79,7 @@ impl RunRow {
             skating: 0.0,
             max_accel: 0.0,
             bone_error: 0.0,
+            plausible: 0.0,
             seconds_per_sample: 0.0,
             failure: None,
             features: Vec::new(),
@@ -131,6 +135,11 @@ pub fn run_task(
     row.skating = mean(all.iter().map(|m| foot_skating_ratio(m)));
     row.max_accel = mean(all.iter().map(|m| max_acceleration(m)));
     row.bone_error = mean(all.iter().map(|m| max_bone_error(m)));
+    let envelope = crate::dataset::envelope::Envelope::builtin();
+    let prompts: Vec<Option<String>> = task.prompts.iter().cloned().map(Some).collect();
+    row.plausible = mean(result.motions.iter().map(|people| {
+        f32::from(crate::metrics::plausibility::check(people, &prompts, &envelope).ok)
+    }));
     row.seconds_per_sample = result.seconds / task.samples.max(1) as f64;
     let per_motion = task.frames * FEATURE_DIM;
     row.features = result

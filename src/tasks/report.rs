@@ -74,9 +74,11 @@ pub fn markdown(info: &RunInfo, rows: &[RunRow], realism: &Realism) -> String {
         "\nC.err: the program's total error (keyframes: mean distance, m). Unsuccess: share of \
          samples with any statement or keyframe error above 5 cm. Skating: PMG's foot-skating \
          ratio. Accel: max joint acceleration (m/frame²). Bones: largest bone-length error against \
-         the skeleton (m; a solver that stretches limbs to meet a constraint shows here). Realism: FID of the solver's motions \
+         the skeleton (m; a solver that stretches limbs to meet a constraint shows here). Plausible: share of \
+         samples whose plausibility report (snaps, floor, skating, overlap, rigid parts, facing against \
+         the shipped envelope of real clips) is clean; higher is better. Realism: FID of the solver's motions \
          against held-out test clips (the evaluator of `mprog eval`; motions in brackets; few \
-         motions make it noisy). Lower is better everywhere."
+         motions make it noisy). Lower is better everywhere else."
     );
     for family in [
         Family::Pmg,
@@ -117,12 +119,12 @@ fn summary(md: &mut String, family: Family, rows: &[&RunRow], realism: &Realism)
     if keyframe {
         let _ = writeln!(
             md,
-            "| solver | avg err (m) | traj err | loc err | unsuccess | skating | accel | bones (m) | realism (FID) | s/sample |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+            "| solver | avg err (m) | traj err | loc err | unsuccess | skating | accel | bones (m) | plausible | realism (FID) | s/sample |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
         );
     } else {
         let _ = writeln!(
             md,
-            "| solver | C.err | unsuccess | skating | accel | bones (m) | realism (FID) | s/sample |\n| --- | --- | --- | --- | --- | --- | --- | --- |"
+            "| solver | C.err | unsuccess | skating | accel | bones (m) | plausible | realism (FID) | s/sample |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
         );
     }
     for solver in solvers_in_order(rows) {
@@ -140,10 +142,11 @@ fn summary(md: &mut String, family: Family, rows: &[&RunRow], realism: &Realism)
             .sum::<f64>()
             / rs.iter().filter(|r| r.failure.is_none()).count().max(1) as f64;
         let tail = format!(
-            "{:.3} | {:.3} | {:.3} | {} | {secs:.1} |",
+            "{:.3} | {:.3} | {:.3} | {:.2} | {} | {secs:.1} |",
             avg(&rs, |r| r.skating),
             avg(&rs, |r| r.max_accel),
             avg(&rs, |r| r.bone_error),
+            avg(&rs, |r| r.plausible),
             realism_cell(realism, family, &solver)
         );
         if keyframe {

@@ -241,6 +241,13 @@ impl Pass<'_> {
                     let points: Vec<(usize, usize)> = persons.iter().map(|&p| (p, 1)).collect();
                     joint_bounds(&points, last_frame(*domain), self.starts, lim)
                 }
+                Op::Time { domain } => {
+                    let frames = ir.resolve_domain(*domain, ir.length);
+                    let fps = f64::from(crate::skeleton::FPS);
+                    let lo = frames.iter().min().map_or(0.0, |&f| f as f64 / fps);
+                    let hi = frames.iter().max().map_or(0.0, |&f| f as f64 / fps);
+                    vec![Iv::new(lo, hi)]
+                }
                 Op::Component { arg, axis } => vec![broadcast(get(*arg), *axis)],
                 Op::Compose(a) => a.iter().map(|&i| broadcast(get(i), 0)).collect(),
                 Op::Unary { op, arg } => unary(*op, get(*arg)),

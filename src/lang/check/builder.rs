@@ -120,6 +120,18 @@ impl Builder {
         })
     }
 
+    /// Seconds since the start at each frame of `domain` (`time`): per frame, not motion.
+    pub fn time(&mut self, domain: DomainId, span: Span) -> NodeId {
+        self.push(Node {
+            op: Op::Time { domain },
+            span,
+            frames: Frames::Domain(domain),
+            lanes: 1,
+            channels: 1,
+            motion: false,
+        })
+    }
+
     fn merge_frames(&self, a: Frames, b: Frames) -> Frames {
         match (a, b) {
             (Frames::Const, x) | (x, Frames::Const) => x,

@@ -64,6 +64,30 @@ pub const BUILTINS: &[BuiltinDoc] = &[
         "atan2(facing().x, facing().z) < 30 deg",
     ),
     b(
+        "bodyFront",
+        "bodyFront(person?)",
+        0,
+        1,
+        "Unit vector out of the front of the torso, in 3-D (it tilts with the torso, unlike `facing`): bodyLeft × bodyUp. Standing it is `facing()`; lying on the back it points up.",
+        "at end { dot(bodyFront(), [0, 1, 0]) > 0.9 }",
+    ),
+    b(
+        "bodyLeft",
+        "bodyLeft(person?)",
+        0,
+        1,
+        "Unit vector to the torso's own left: the right-to-left direction of the hips and of the shoulders (each normalised, summed), made perpendicular to bodyUp. Standing facing +Z it is +X.",
+        "always { dot(normalize(l_hand - l_shoulder), bodyLeft()) > 0.8 }",
+    ),
+    b(
+        "bodyUp",
+        "bodyUp(person?)",
+        0,
+        1,
+        "Unit vector along the spine, pelvis to neck: +Y standing upright, horizontal lying down. With bodyLeft and bodyFront it makes a right-handed frame (left × up = front).",
+        "at end { dot(bodyUp(), [0, 1, 0]) < 0.3 }",
+    ),
+    b(
         "clamp",
         "clamp(x, lo, hi)",
         3,
@@ -76,7 +100,7 @@ pub const BUILTINS: &[BuiltinDoc] = &[
         "cos(a)",
         1,
         1,
-        "Cosine of an angle.",
+        "Cosine of an angle: a plain number, which takes the unit of what it meets (`0.3 * cos(a)` next to metres is metres).",
         "cos(angle(bone(l_elbow), [1,0,0])) > 0.9",
     ),
     b(
@@ -102,6 +126,14 @@ pub const BUILTINS: &[BuiltinDoc] = &[
         1,
         "Horizontal unit vector the body faces, from the hips and shoulders (forward = up × (right − left)).",
         "dot(facing(), [1,0,0]) > 0.9",
+    ),
+    b(
+        "gaze",
+        "gaze(person?)",
+        0,
+        1,
+        "Where the head faces, from what the 22 joints carry: perpendicular to the shoulder line and tilted with the neck-to-head bone (tipping the head forward looks down, back looks up), raised 25° so an upright head looks level. The skeleton has no face joints, so turning the head on its own neck (yaw) is not seen: looking left or over a shoulder is measured by the shoulders turning, and a head tilted sideways counts as level.",
+        "during 2s..3s { dot(gaze(), [1, 0, 0]) > 0.7 }",
     ),
     b(
         "massCtr",
@@ -164,7 +196,7 @@ pub const BUILTINS: &[BuiltinDoc] = &[
         "sin(a)",
         1,
         1,
-        "Sine of an angle.",
+        "Sine of an angle: a plain number, like `cos`.",
         "sin(30 deg) * 1 m < head.y",
     ),
     b(

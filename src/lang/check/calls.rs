@@ -12,6 +12,11 @@ use crate::lang::syntax::ast::*;
 use crate::skeleton::{FPS, PARENTS, joint_mass_weights};
 use std::rc::Rc;
 
+/// How far (degrees) the neck→head bone leans forward of the head's up when the head is
+/// level: HumanML3D's head joint sits ahead of the neck. From clip 012314's upright frames
+/// (20–30°); `gaze` raises its direction by this much.
+pub const NEUTRAL_HEAD_PITCH: f64 = 25.0;
+
 /// Deepest nesting of function calls (inlining) allowed.
 pub const MAX_CALL_DEPTH: usize = 32;
 
@@ -109,7 +114,12 @@ impl<'a> Checker<'a> {
             .help("simplify the chain of functions calling functions");
             return Val::Error;
         }
-        let mut fenv: Env<'a> = None;
+        // A user function sees the top-level `let`s declared above it; a library one
+        // sees only its arguments and the library.
+        let mut fenv: Env<'a> = match (self.user_fns.get(n), self.fn_envs.get(n)) {
+            (Some(g), Some(env)) if std::ptr::eq(*g, f) => env.clone(),
+            _ => None,
+        };
         for (p, a) in f.params.iter().zip(args) {
             fenv = bind(
                 &fenv,
@@ -310,6 +320,22 @@ impl<'a> Checker<'a> {
                 };
                 num(self.facing(&p, span, cx), Unit::ONE, true)
             }
+            "bodyFront" | "bodyLeft" | "bodyUp" | "gaze" => {
+                let Some(p) = self.person_arg(args, 0, b, span, env, cx) else {
+                    return Val::Error;
+                };
+                let node = if b.name == "gaze" {
+                    self.gaze(&p, span, cx)
+                } else {
+                    let [left, up, front] = self.body_axes(&p, span, cx);
+                    match b.name {
+                        "bodyFront" => front,
+                        "bodyLeft" => left,
+                        _ => up,
+                    }
+                };
+                num(node, Unit::ONE, true)
+            }
             "supportDist" => {
                 let Some(point) = self.num(&args[0], env, cx) else {
                     return Val::Error;
@@ -440,6 +466,54 @@ impl<'a> Checker<'a> {
         let nx = self.b.unary(UnaryOp::Neg, ax, span);
         let fwd = self.b.compose([az, zero, nx], span);
         self.normalize(fwd, span)
+    }
+
+    /// Joint `j` of each lane's person, on the current frames.
+    fn joint_of(&mut self, persons: &[usize], j: usize, span: Span, cx: &Cx) -> usize {
+        let pts = persons.iter().map(|&q| (q, j)).collect();
+        self.b.gather(cx.domain, pts, span)
+    }
+
+    /// The torso's own frame `[left, up, front]`, unit vectors, right-handed
+    /// (left × up = front): up runs from the pelvis to the neck; front is perpendicular to
+    /// up and to the hips' and shoulders' right-to-left direction; left = up × front is
+    /// that direction made perpendicular to up. Standing facing +Z with the left at +X it
+    /// is (+X, +Y, +Z).
+    fn body_axes(&mut self, p: &LaneVec, span: Span, cx: &Cx) -> [usize; 3] {
+        let persons = self.per_lane(p, cx);
+        let [pelvis, lh, rh, neck, ls, rs] =
+            [0, 1, 2, 12, 16, 17].map(|j| self.joint_of(&persons, j, span, cx));
+        let hips = self.b.binary(BinaryOp::Sub, lh, rh, span);
+        let shoulders = self.b.binary(BinaryOp::Sub, ls, rs, span);
+        let hips = self.normalize(hips, span);
+        let shoulders = self.normalize(shoulders, span);
+        let across = self.b.binary(BinaryOp::Add, hips, shoulders, span);
+        let spine = self.b.binary(BinaryOp::Sub, neck, pelvis, span);
+        let up = self.normalize(spine, span);
+        let front = self.b.cross(across, up, span);
+        let front = self.normalize(front, span);
+        let left = self.b.cross(up, front, span);
+        [left, up, front]
+    }
+
+    /// Where the head faces: perpendicular to the shoulder line L (left − right shoulder)
+    /// and to the neck→head bone h, i.e. g0 = normalise(L × h), then raised by
+    /// [`NEUTRAL_HEAD_PITCH`] about L (g0·cos α + (g0 × L̂)·sin α), since the head joint
+    /// sits ahead of the neck's axis when the head is level.
+    fn gaze(&mut self, p: &LaneVec, span: Span, cx: &Cx) -> usize {
+        let persons = self.per_lane(p, cx);
+        let [neck, head, ls, rs] = [12, 15, 16, 17].map(|j| self.joint_of(&persons, j, span, cx));
+        let shoulders = self.b.binary(BinaryOp::Sub, ls, rs, span);
+        let l = self.normalize(shoulders, span);
+        let bone = self.b.binary(BinaryOp::Sub, head, neck, span);
+        let g0 = self.b.cross(l, bone, span);
+        let g0 = self.normalize(g0, span);
+        let raised = self.b.cross(g0, l, span);
+        let (s, c) = NEUTRAL_HEAD_PITCH.to_radians().sin_cos();
+        let (ks, kc) = (self.b.konst(&[s], span), self.b.konst(&[c], span));
+        let a = self.b.binary(BinaryOp::Mul, g0, kc, span);
+        let b = self.b.binary(BinaryOp::Mul, raised, ks, span);
+        self.b.binary(BinaryOp::Add, a, b, span)
     }
 
     /// `v / norm(v)`.

@@ -203,6 +203,16 @@ impl<'a> Checker<'a> {
             }
             "people" => return Val::PersonSet((0..self.header.people.len()).collect()),
             "me" if !self.multi => return Val::Person(LaneVec::One(0)),
+            "time" => {
+                // Seconds since the start, per frame of the current domain: a constant of
+                // the frame (it does not depend on the motion), vectorised over frames.
+                let node = self.b.time(cx.domain, span);
+                return Val::Num(Num {
+                    node,
+                    unit: Unit::S,
+                    vector: false,
+                });
+            }
             "start" | "mid" | "end" => {
                 self.error(
                     cx,
@@ -246,13 +256,77 @@ impl<'a> Checker<'a> {
 
     /// Reports an unknown name with the closest known one.
     fn unknown_name(&mut self, n: &str, span: Span, env: &Env<'a>, cx: &Cx) {
+        // The user function whose body this use is in (user code only: inside a library
+        // call, diagnostics move to the call site).
+        let in_fn: Option<(&'a str, Span)> = if cx.site.is_none() {
+            self.user_fns
+                .values()
+                .find(|f| f.span.start <= span.start && span.end <= f.span.end)
+                .map(|f| (f.name.name.as_str(), f.span))
+        } else {
+            None
+        };
+        let later_let = self
+            .top_lets
+            .iter()
+            .find(|(m, _)| *m == n)
+            .map(|&(_, s)| s)
+            .filter(|_| cx.site.is_none());
+        if let Some(let_span) = later_let {
+            let line = self.line_of(let_span.start);
+            match in_fn {
+                Some((f, fspan)) if let_span.start > fspan.start => {
+                    self.error(
+                        cx,
+                        crate::lang::codes::UNKNOWN_NAME,
+                        span,
+                        format!("`{n}` is declared on line {line}, after the function `{f}`"),
+                    )
+                    .label("not visible in this function")
+                    .help(format!(
+                        "move the `let` above `def {f}`: a function sees its arguments, the \
+                         `param`s, and the `let`s declared above it"
+                    ));
+                    return;
+                }
+                None if let_span.start > span.start => {
+                    self.error(
+                        cx,
+                        crate::lang::codes::UNKNOWN_NAME,
+                        span,
+                        format!("`{n}` is declared on line {line}, after this use"),
+                    )
+                    .label("not declared yet")
+                    .help("move the `let` above its first use: a `let` is visible below it");
+                    return;
+                }
+                _ => {}
+            }
+        }
+        if matches!(
+            n,
+            "s" | "ms" | "m" | "cm" | "mm" | "deg" | "rad" | "frame" | "frames"
+        ) {
+            self.error(
+                cx,
+                crate::lang::codes::UNKNOWN_NAME,
+                span,
+                format!("`{n}` is a unit, not a value"),
+            )
+            .label("a unit alone")
+            .help(format!(
+                "write a unit right after a number (`2 {n}`); a rate per second is written \
+                 without spaces, `180 deg/s` or `1.5 m/s`"
+            ));
+            return;
+        }
         let mut candidates: Vec<String> = all_joint_names().map(str::to_string).collect();
         let joint_count = candidates.len();
         candidates.extend(names(env).into_iter().map(str::to_string));
         candidates.extend(self.header.params.iter().map(|p| p.name.clone()));
         candidates.extend(self.header.people.iter().map(|p| p.name.clone()));
         candidates.extend(self.lib_lets.keys().map(|k| k.to_string()));
-        candidates.extend(["joints", "people"].map(String::from));
+        candidates.extend(["joints", "people", "time"].map(String::from));
         let best = did_you_mean(n, candidates.iter().map(String::as_str)).map(str::to_string);
         let is_joint = best
             .as_ref()
@@ -263,11 +337,17 @@ impl<'a> Checker<'a> {
             crate::lang::codes::UNKNOWN_NAME
         };
         let what = if is_joint { "joint" } else { "name" };
-        let help = match best {
-            Some(b) => format!("did you mean `{b}`?"),
-            None => "joints are named like `head`, `l_hand`, `right_foot` (see `mprog joints`); \
-                     declare values with `let` or `param`"
-                .to_string(),
+        let help = match (best, in_fn) {
+            (Some(b), _) => format!("did you mean `{b}`?"),
+            (None, Some((f, _))) => format!(
+                "`{f}` sees its arguments, the `param`s, and the `let`s declared above it; \
+                 joints are named like `head`, `l_hand`, `right_foot` (see `mprog joints`)"
+            ),
+            (None, None) => {
+                "joints are named like `head`, `l_hand`, `right_foot` (see `mprog joints`); \
+                 declare values with `let` or `param`"
+                    .to_string()
+            }
         };
         self.error(cx, code, span, format!("unknown {what} `{n}`"))
             .label("not defined")
@@ -531,7 +611,7 @@ impl<'a> Checker<'a> {
             || self.header.people.iter().any(|p| p.name == n)
             || joint_index(n).is_some()
             || self.lib_lets.contains_key(n)
-            || matches!(n, "joints" | "people")
+            || matches!(n, "joints" | "people" | "time")
             || (n == "me" && !self.multi)
     }
 }

@@ -122,9 +122,11 @@ pub fn hint(cause: Cause, last_frame: usize) -> String {
     match cause {
         Cause::AtStart => {
             "at frame 0 each person's pelvis is pinned to its start place (x = z = 0 \
-             with one person; see `spacing` for two or more), so a ground position at `start` \
-             can only restate it. Put the constraint at a later time (`at 1s`, `at end`), or \
-             write places relative to the start (`pelvis@start + [0, 0, 3]`)"
+             with one person unless placed; see `spacing` for two or more), so a ground \
+             position at `start` can only restate it. Place the person there \
+             (`start at [x, 0, z]`, or `at [x, 0, z]` after a person's prompt), put the \
+             constraint at a later time (`at 1s`, `at end`), or write places relative to the \
+             start (`pelvis@start + [0, 0, 3]`)"
                 .to_string()
         }
         Cause::IncludesStart => "this block includes frame 0, where each person's pelvis is \

@@ -17,7 +17,7 @@ const MAX_SPACING: f64 = 20.0;
 
 /// Names a person, parameter or function may not take.
 pub const RESERVED: &[&str] = &[
-    "x", "y", "z", "xz", "me", "joints", "people", "start", "mid", "end", "true", "false",
+    "x", "y", "z", "xz", "me", "joints", "people", "start", "mid", "end", "time", "true", "false",
 ];
 
 impl<'a> Checker<'a> {
@@ -94,9 +94,10 @@ impl<'a> Checker<'a> {
         }
         self.declare_length(module, &cx);
         self.declare_spacing(module, &cx);
+        self.declare_starts(module, &cx);
     }
 
-    fn duplicate_header(&mut self, cx: &Cx, what: &str, span: Span, first: Span) {
+    pub(super) fn duplicate_header(&mut self, cx: &Cx, what: &str, span: Span, first: Span) {
         let line = self.line_of(first.start);
         self.error(
             cx,
@@ -211,6 +212,7 @@ impl<'a> Checker<'a> {
                     }
                 }
             }
+            calls.extend(self.calls_through_lets(f));
             calls.retain(|c| self.user_fns.contains_key(c));
             graph.insert(name, calls);
         }

@@ -28,6 +28,7 @@ mod header;
 mod numeric;
 mod ops;
 pub mod reach;
+mod start;
 mod stmt;
 mod time;
 pub mod units;
@@ -92,6 +93,9 @@ pub struct Header {
     pub people: Vec<PersonInfo>,
     /// `spacing`: metres between neighbouring people at the start (`None`: the default).
     pub spacing: Option<f64>,
+    /// Declared starts (`at`/`facing`), one per person, or empty when none is declared.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub starts: Vec<crate::lang::ir::StartOverride>,
     /// Parameters.
     pub params: Vec<ParamInfo>,
 }
@@ -121,6 +125,11 @@ pub(crate) struct Checker<'a> {
     pub user_fns: HashMap<&'a str, &'a FnDef>,
     pub lib_fns: HashMap<&'a str, &'a FnDef>,
     pub lib_lets: HashMap<&'a str, &'a Expr>,
+    /// What each user function's body sees besides its arguments: the top-level `let`s
+    /// declared above it.
+    pub fn_envs: HashMap<&'a str, values::Env<'a>>,
+    /// The top-level `let`s, in source order (for "declared after" diagnostics).
+    pub top_lets: Vec<(&'a str, Span)>,
     /// Recursive functions (reported once; calls to them elaborate to errors).
     pub poisoned: std::collections::HashSet<&'a str>,
     /// Expressions elaborated so far (see [`MAX_WORK`]).
@@ -219,6 +228,8 @@ pub fn module_to_ir<'a>(
         user_fns: HashMap::new(),
         lib_fns: HashMap::new(),
         lib_lets: HashMap::new(),
+        fn_envs: HashMap::new(),
+        top_lets: Vec::new(),
         poisoned: Default::default(),
         work: 0,
         statements: Vec::new(),
@@ -226,6 +237,7 @@ pub fn module_to_ir<'a>(
         contacts: Vec::new(),
     };
     c.load_library(library);
+    c.scope_of_functions(module);
     c.header_items(module, overrides);
     let header_ok = !c.diags.iter().any(|d| d.severity == Severity::Error);
     c.body(module);
@@ -382,6 +394,7 @@ impl Checker<'_> {
             people: self.header.people.len(),
             length: self.header.length,
             spacing: self.header.spacing,
+            starts: self.header.starts.clone(),
         }
     }
 }

@@ -135,7 +135,14 @@ impl<'a> Checker<'a> {
                 c.args[0].span,
                 format!("`{name}` needs an angle, found {}", v[0].unit),
             )
-            .help("write angles with `deg` or `rad`, e.g. `sin(30 deg)`");
+            .help(if v[0].unit == Unit::S {
+                format!(
+                    "a time is not an angle: multiply it by an angular rate, e.g. \
+                     `{name}(180 deg/s * time)` (half a turn per second)"
+                )
+            } else {
+                "write angles with `deg` or `rad`, e.g. `sin(30 deg)`".to_string()
+            });
             return Val::Error;
         }
         let op = if name == "sin" {
@@ -143,7 +150,9 @@ impl<'a> Checker<'a> {
         } else {
             UnaryOp::Cos
         };
-        num(self.b.unary(op, v[0].node, c.span), Unit::ONE, false)
+        // A plain number, like a literal: `0.3 * cos(a)` takes the unit of what it meets
+        // (`[0.3 * cos(a), 1.2, 0.3 * sin(a)]` is a point in metres).
+        num(self.b.unary(op, v[0].node, c.span), Unit::FREE, false)
     }
 
     /// `min`, `max` or `atan2` of two scalars or two vectors in one unit.

@@ -6,10 +6,14 @@
 
 use super::values::*;
 use super::{Checker, units::Unit};
-use crate::lang::ir::{BinaryOp, Domain, NodeId, Statement, UnaryOp};
+use crate::lang::ir::{BinaryOp, Domain, NodeId, Op, Statement, UnaryOp};
 use crate::lang::syntax::ast::*;
 use crate::skeleton::joint_index;
 use std::rc::Rc;
+
+/// A single-frame `at` this close to the end (frames) is an end state for
+/// `mprog::keyframe_pose`: 0.25 s.
+const END_FRAMES: usize = 5;
 
 /// Most loop lanes (product of nested loop sizes) a statement may have.
 pub const MAX_LANES: usize = 4096;
@@ -52,6 +56,98 @@ impl<'a> Checker<'a> {
                 }
             }
         }
+    }
+
+    /// Records what each user function sees: the top-level `let`s declared above it (in
+    /// source order, as the statements see them), and where every top-level `let` is.
+    pub fn scope_of_functions(&mut self, module: &'a Module) {
+        let mut env: Env<'a> = None;
+        for item in &module.items {
+            match item {
+                Item::Stmt(Stmt::Let {
+                    name, value, span, ..
+                }) => {
+                    let n = name.name.as_str();
+                    self.top_lets.push((n, *span));
+                    // A reserved name is reported (and left unbound) by `stmt`.
+                    if joint_index(n).is_none() && !super::header::RESERVED.contains(&n) {
+                        env = bind(
+                            &env,
+                            n,
+                            Binding::Thunk {
+                                expr: value,
+                                env: env.clone(),
+                                site: None,
+                            },
+                        );
+                    }
+                }
+                Item::Def(f) => {
+                    self.fn_envs
+                        .entry(f.name.name.as_str())
+                        .or_insert_with(|| env.clone());
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// The functions `f` calls through the top-level `let`s it sees (`let k = f(1)` above
+    /// `def f(a) = k + a` is a recursion): names its body reads that are no argument or
+    /// block `let` of its own, followed into the `let`s' values.
+    pub fn calls_through_lets(&self, f: &'a FnDef) -> Vec<&'a str> {
+        let Some(env) = self.fn_envs.get(f.name.name.as_str()) else {
+            return Vec::new();
+        };
+        let mut own: Vec<&str> = f.params.iter().map(|p| p.name.as_str()).collect();
+        let mut roots: Vec<&'a Expr> = Vec::new();
+        match &f.body {
+            FnBody::Expr(e) => roots.push(e),
+            FnBody::Block(items) => {
+                for i in items {
+                    match i {
+                        FnItem::Let { name, value } => {
+                            own.push(name.name.as_str());
+                            roots.push(value);
+                        }
+                        FnItem::Expr(e) => roots.push(e),
+                    }
+                }
+            }
+        }
+        let mut out = Vec::new();
+        let mut seen: Vec<*const Expr> = Vec::new();
+        // (expression, the scope its names resolve in, whether it is the function's own)
+        let mut stack: Vec<(&'a Expr, Env<'a>, bool)> =
+            roots.into_iter().map(|e| (e, env.clone(), true)).collect();
+        while let Some((e, scope, body)) = stack.pop() {
+            match &e.kind {
+                ExprKind::Name(n) if !(body && own.contains(&n.as_str())) => {
+                    if let Some(Binding::Thunk { expr, env, .. }) = lookup(&scope, n)
+                        && !seen.contains(&(expr as *const Expr))
+                    {
+                        seen.push(expr);
+                        stack.push((expr, env, false));
+                    }
+                }
+                ExprKind::Call(name, args) => {
+                    out.push(name.name.as_str());
+                    stack.extend(args.iter().map(|a| (a, scope.clone(), body)));
+                }
+                ExprKind::List(items) => {
+                    stack.extend(items.iter().map(|a| (a, scope.clone(), body)));
+                }
+                ExprKind::Member(a, _) | ExprKind::Unary(_, a) => {
+                    stack.push((a, scope.clone(), body));
+                }
+                ExprKind::At(a, b) | ExprKind::Binary(_, a, b) => {
+                    stack.push((a, scope.clone(), body));
+                    stack.push((b, scope.clone(), body));
+                }
+                _ => {}
+            }
+        }
+        out
     }
 
     fn error_count(&self) -> usize {
@@ -117,7 +213,13 @@ impl<'a> Checker<'a> {
                     weight: scx.weight * w,
                     ..scx.clone()
                 };
+                let emitted = self.statements.len();
                 self.block(body, &env, &inner);
+                if let TimeKind::At(times) = kind
+                    && let [t] = times.as_slice()
+                {
+                    self.keyframe_pose([d, domain], t, *span, emitted, cx);
+                }
             }
             Stmt::Weight { weight, body, .. } => {
                 let w = self.weight(Some(weight), &env, cx);
@@ -189,6 +291,113 @@ impl<'a> Checker<'a> {
             }
         }
         env
+    }
+
+    /// `mprog::keyframe_pose`: a one-time `at` block on one of the last [`END_FRAMES`]
+    /// frames (`at end`) whose constraints fix the body's posture there: the absolute
+    /// height of the pelvis, a spine joint, the neck, the head or the centre of mass, or
+    /// absolute heights of two or more joints other than the feet and ankles. A height is
+    /// absolute when the statement reads the `.y` of one joint on the block's frame
+    /// (`pelvis.y < 0.5 m`, `head.y < pelvis@start.y`), not a difference of two
+    /// (`r_hand.y > head.y`). Ground positions, facing and contacts of a hand or two are
+    /// not posture.
+    fn keyframe_pose(
+        &mut self,
+        domains: [usize; 2],
+        t: &Expr,
+        span: Span,
+        emitted: usize,
+        cx: &Cx,
+    ) {
+        let frame = match &self.b.domains[domains[0]] {
+            Domain::At(points) if points.len() == 1 => points[0].frame(self.header.length),
+            _ => return,
+        };
+        // End states only: an interior keyframe is usually a moment (a squat's bottom, a
+        // jump's apex, a duck under a bar), which the motion passes through on purpose.
+        if frame + END_FRAMES < self.header.length {
+            return;
+        }
+        const TORSO: [usize; 6] = [0, 3, 6, 9, 12, 15];
+        const FEET: [usize; 4] = [7, 8, 10, 11];
+        let mut torso: Option<String> = None;
+        let mut heights: Vec<(usize, usize)> = Vec::new();
+        for s in &self.statements[emitted..] {
+            if s.objective {
+                continue;
+            }
+            // Joint reads under a `.y`, on the statement's own frames.
+            let mut seen = std::collections::HashSet::new();
+            let mut stack = vec![(s.error, false)];
+            let mut reads: Vec<NodeId> = Vec::new();
+            while let Some((n, y)) = stack.pop() {
+                if !seen.insert((n, y)) {
+                    continue;
+                }
+                let node = &self.b.nodes[n];
+                match &node.op {
+                    Op::Component { arg, axis } => stack.push((*arg, *axis == 1)),
+                    Op::Gather { domain: d, .. } | Op::MassCenter { domain: d, .. } => {
+                        if y && domains.contains(d) && !reads.contains(&n) {
+                            reads.push(n);
+                        }
+                    }
+                    op => stack.extend(op.args().into_iter().map(|a| (a, y))),
+                }
+            }
+            // One joint read: an absolute height. Two or more: a difference of heights.
+            let [n] = reads.as_slice() else { continue };
+            match &self.b.nodes[*n].op {
+                Op::MassCenter { .. } => {
+                    torso.get_or_insert_with(|| "the centre of mass".to_string());
+                }
+                Op::Gather { points, .. } => {
+                    for &(p, j) in points {
+                        if TORSO.contains(&j) {
+                            torso.get_or_insert_with(|| {
+                                format!("the {}", crate::skeleton::JOINT_NAMES[j])
+                            });
+                        } else if !FEET.contains(&j) && !heights.contains(&(p, j)) {
+                            heights.push((p, j));
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+        let what = match (&torso, heights.len()) {
+            (Some(t), _) => format!("the height of {t}"),
+            (None, k) if k >= 2 => {
+                let names: Vec<&str> = heights
+                    .iter()
+                    .map(|&(_, j)| crate::skeleton::JOINT_NAMES[j])
+                    .collect();
+                format!("the heights of the {}", names.join(", the "))
+            }
+            _ => return,
+        };
+        let time = self
+            .source
+            .get(t.span.start..t.span.end)
+            .unwrap_or("end")
+            .to_string();
+        let window = if time == "end" {
+            "during end - 0.5s..end + 1".to_string()
+        } else {
+            format!("during {time} - 0.5s..end + 1")
+        };
+        self.error(
+            cx,
+            crate::lang::codes::KEYFRAME_POSE,
+            Span::new(span.start, t.span.end),
+            format!("`at {time}` fixes a whole-body pose ({what}) on a single frame"),
+        )
+        .label("one frame")
+        .help(format!(
+            "only the last frame would be in this pose, so the body snaps into it at the very \
+             end; hold the end state over a window instead: `{window} {{ … }}`"
+        ))
+        .warning();
     }
 
     fn weight(&mut self, e: Option<&'a Expr>, env: &Env<'a>, cx: &Cx) -> f64 {

@@ -46,6 +46,10 @@ impl<'a> Checker<'a> {
                     let inner = Cx { site, ..cx.clone() };
                     return self.time_point(expr, &tenv, &inner);
                 }
+                if n == "time" {
+                    self.not_a_time(e, cx, "`time`, the time of each frame (a value)");
+                    return None;
+                }
                 let param = self.header.params.iter().find(|p| &p.name == n).cloned();
                 match param {
                     Some(p) if p.value.len() == 1 && p.unit_value == Unit::S => {

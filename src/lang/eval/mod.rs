@@ -147,6 +147,23 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
                 .reshape([1, 1, 1, c]);
             consts.insert(i, t);
         }
+        if let Op::Time { domain } = &node.op {
+            // Seconds at each frame of the domain: one small constant tensor per frame count.
+            let fps = crate::skeleton::FPS;
+            let mut secs: Vec<f32> = ir
+                .resolve_domain(*domain, frames)
+                .into_iter()
+                .map(|t| t as f32 / fps)
+                .collect();
+            if secs.is_empty() {
+                secs.push(0.0);
+            }
+            let n = secs.len();
+            let t =
+                Tensor::<1>::from_data(TensorData::new(secs, [n]), device).reshape([1, n, 1, 1]);
+            consts.insert(i, t);
+            continue;
+        }
         let (domain, points): (DomainId, Vec<(usize, usize)>) = match &node.op {
             Op::Gather { domain, points } => (*domain, points.clone()),
             Op::MassCenter {
@@ -268,7 +285,7 @@ fn with_node_values<T>(
             Frames::Domain(d) => idx.domain_sizes[d].max(1),
         };
         let t = match &node.op {
-            Op::Const(_) => idx.consts[&i].clone(),
+            Op::Const(_) | Op::Time { .. } => idx.consts[&i].clone(),
             Op::Gather { .. } => {
                 // [batch, |D|·K, 3] → [batch, |D|, K, 3]
                 let g = gather_rows(&rows, merged.as_ref(), idx, i);

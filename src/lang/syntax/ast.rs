@@ -57,6 +57,8 @@ pub enum Item {
     },
     /// `people a "…", b "…"`.
     People { people: Vec<PersonDecl>, span: Span },
+    /// `start at [x, 0, z] facing [dx, 0, dz]`: where the one person stands on frame 0.
+    Start { place: StartPlace, span: Span },
     /// `def f(a, b) = …` or `def f(a) { … }`.
     Def(FnDef),
     /// A statement (constraints, blocks, `let`).
@@ -70,6 +72,19 @@ pub struct PersonDecl {
     pub name: Ident,
     /// Their text prompt, if given.
     pub prompt: Option<String>,
+    /// `at [x, 0, z] facing [dx, 0, dz]` after the prompt, if given.
+    pub start: Option<StartPlace>,
+}
+
+/// Where a person stands on frame 0: a position on the floor, a facing direction, or both.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StartPlace {
+    /// `at [x, 0, z]`.
+    pub at: Option<Expr>,
+    /// `facing [dx, 0, dz]`.
+    pub facing: Option<Expr>,
+    /// The whole `at … facing …` text.
+    pub span: Span,
 }
 
 /// A user function.

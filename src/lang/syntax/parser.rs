@@ -119,6 +119,7 @@ fn rule_name(rule: &Rule) -> String {
         Rule::ident => "a name",
         Rule::number | Rule::num_lit => "a number",
         Rule::unit => "a unit (m, cm, s, frames, deg, %)",
+        Rule::per_s => "`/s`",
         Rule::string => "a quoted string",
         Rule::block => "`{`",
         Rule::weight_suffix => "`weight`",
@@ -129,10 +130,15 @@ fn rule_name(rule: &Rule) -> String {
         Rule::at_time => "`@`",
         Rule::param_list => "parameter names",
         Rule::person => "a person name",
+        Rule::start_place | Rule::start_at | Rule::start_facing | Rule::kw_facing => {
+            "`at [x, 0, z]` or `facing [dx, 0, dz]`"
+        }
+        Rule::kw_start => "`start`",
         Rule::fn_block => "`{`",
         Rule::prompt_decl
         | Rule::length_decl
         | Rule::spacing_decl
+        | Rule::start_decl
         | Rule::param_decl
         | Rule::people_decl
         | Rule::def_decl
@@ -268,19 +274,59 @@ impl Builder<'_> {
                     .filter_map(|p| {
                         let mut inner = p.into_inner();
                         let name = ident(inner.next()?);
-                        let prompt = inner
-                            .next()
-                            .and_then(|s| s.into_inner().next())
-                            .map(|s| unescape(s.as_str()));
-                        Some(PersonDecl { name, prompt })
+                        let mut prompt = None;
+                        let mut start = None;
+                        for part in inner {
+                            match part.as_rule() {
+                                Rule::string => {
+                                    prompt = part.into_inner().next().map(|s| unescape(s.as_str()))
+                                }
+                                Rule::start_place => start = Some(self.start_place(part)),
+                                _ => {}
+                            }
+                        }
+                        Some(PersonDecl {
+                            name,
+                            prompt,
+                            start,
+                        })
                     })
                     .collect();
                 Item::People { people, span }
             }
+            Rule::start_decl => Item::Start {
+                place: self.start_place(
+                    pair.into_inner()
+                        .find(|p| p.as_rule() == Rule::start_place)?,
+                ),
+                span,
+            },
             Rule::def_decl => Item::Def(self.def(pair)?),
             Rule::EOI => return None,
             _ => Item::Stmt(self.stmt(pair)?),
         })
+    }
+
+    /// `at [x, 0, z] facing [dx, 0, dz]` (either part may be missing).
+    fn start_place(&self, pair: Pair<Rule>) -> StartPlace {
+        let span = span_of(&pair);
+        let mut place = StartPlace {
+            at: None,
+            facing: None,
+            span,
+        };
+        for part in pair.into_inner() {
+            let rule = part.as_rule();
+            let Some(e) = part.into_inner().find(|p| p.as_rule() == Rule::expr) else {
+                continue;
+            };
+            match rule {
+                Rule::start_at => place.at = Some(self.expr(e)),
+                Rule::start_facing => place.facing = Some(self.expr(e)),
+                _ => {}
+            }
+        }
+        place
     }
 
     fn def(&self, pair: Pair<Rule>) -> Option<FnDef> {
@@ -531,7 +577,11 @@ impl Builder<'_> {
             Rule::number => {
                 let mut inner = pair.into_inner();
                 let value = inner.next().and_then(|n| n.as_str().parse::<f64>().ok());
-                let unit = inner.next().map(|u| match u.as_str() {
+                let unit_pair = inner.next();
+                let unit_end = unit_pair.as_ref().map_or(span.end, |u| u.as_span().end());
+                // `180 deg/s` is `180 deg / 1 s`: a rate, in the units' own arithmetic.
+                let per_s = inner.next().map(|p| span_of(&p));
+                let unit = unit_pair.map(|u| match u.as_str() {
                     "m" => UnitLit::M,
                     "cm" => UnitLit::Cm,
                     "mm" => UnitLit::Mm,
@@ -543,7 +593,21 @@ impl Builder<'_> {
                     _ => UnitLit::Percent,
                 });
                 match value {
-                    Some(v) if v.is_finite() => leaf(ExprKind::Number(v, unit)),
+                    Some(v) if v.is_finite() => match per_s {
+                        None => leaf(ExprKind::Number(v, unit)),
+                        Some(per) => {
+                            let num = Expr {
+                                kind: ExprKind::Number(v, unit),
+                                span: Span::new(span.start, unit_end),
+                            };
+                            let one_s = Expr {
+                                kind: ExprKind::Number(1.0, Some(UnitLit::S)),
+                                span: per,
+                            };
+                            let kind = ExprKind::Binary(BinOp::Div, Box::new(num), Box::new(one_s));
+                            (Expr { kind, span }, 2)
+                        }
+                    },
                     _ => {
                         self.diags.borrow_mut().push(
                             Diagnostic::error(

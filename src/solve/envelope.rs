@@ -1,0 +1,252 @@
+//! Inside the real envelope: a penalty on what no recorded person does, for the late
+//! guidance steps beside the foot lock ([`super::feet`]) and the acceleration hold
+//! ([`super::accel`]).
+//!
+//! The late steps move μ directly, with no denoiser after them, so nothing but the
+//! program's gradient shapes those frames: a program that cannot be met smoothly is met
+//! by a snap (a head rising 0.27 m in one frame to reach an `at end` height) or through
+//! the floor (a wrist 13 cm under it while sitting down). The acceleration hold only
+//! slows *changes* to the motion over a step's first iterations; this term bounds the
+//! motion itself, over every iteration of every late step:
+//! * **acceleration**: each joint's `|J[t+1] − 2·J[t] + J[t−1]|` beyond [`ACCEL_LIMITS`],
+//!   the largest that joint reaches in the training data (m/frame² at 20 fps);
+//! * **floor**: any joint below `y = 0`;
+//! * **folding**: the torso curled or the shoulders folded in further than any recorded
+//!   frame ([`MIN_SPANS`]): the late steps met "hand on the head" by hunching the spine to
+//!   0.59 of its length and folding the shoulders to 0.17 m apart, where the training data
+//!   keeps the spine above 0.94 and the shoulders above 0.28 m.
+//!
+//! Both are hinges, so a motion inside the envelope costs nothing and the program's pull
+//! is not spread over the clip (as a hold over all iterations did). A sample's penalty is
+//! `w · (Σ_{t,j} s(|Δ²J_tj| − a_j) / (N − 2) + Σ_{t,j} s(−y_tj) / N + Σ_{t,(a,b)} s(d_ab − |J_ta − J_tb|) / N)` with
+//! `s(e) = √(e² + ε²) − ε` for `e > 0` (0 otherwise), in metres like the program's error.
+
+use crate::skeleton::NUM_JOINTS;
+
+/// Smoothing of the hinge at zero (m or m/frame²).
+const EPS: f32 = 1e-3;
+
+const J3: usize = NUM_JOINTS * 3;
+
+/// The largest acceleration of each joint in the training data (m/frame² at 20 fps, in
+/// joint order): the 99.99th percentile over the 617,612 frame triples of the shipped
+/// model's training set (`data/combined`, Bandai + CMU + HDM05 with mirrors), which leaves
+/// out about 60 frames where the capture jumps (up to 2.8 m/frame²). Measured with
+/// `mprog data envelope` (the `accel_p9999` column; book, "Plausibility").
+pub const ACCEL_LIMITS: [f32; NUM_JOINTS] = [
+    0.083, 0.094, 0.096, 0.087, 0.336, 0.333, 0.108, 0.339, 0.334, 0.108, 0.409, 0.415, 0.136,
+    0.119, 0.120, 0.147, 0.132, 0.131, 0.249, 0.250, 0.429, 0.433,
+];
+
+/// Joint pairs whose distance the training data never takes below a floor (m): the
+/// 0.1st percentile over `data/combined`'s frames (`mprog data envelope`, the `rigid`
+/// table): pelvis–spine3, pelvis–neck, each hip–spine3, and the shoulders (0.283 in the
+/// data, 0.27 here: the skeleton's own rest pose hangs its shoulders 0.281 apart).
+pub const MIN_SPANS: [(usize, usize, f32); 5] = [
+    (0, 9, 0.311),
+    (0, 12, 0.499),
+    (1, 9, 0.307),
+    (2, 9, 0.307),
+    (16, 17, 0.27),
+];
+
+/// The envelope penalty of a batch of motions.
+#[derive(Clone, Debug)]
+pub struct EnvelopeGuard {
+    weight: f32,
+    frames: usize,
+    people: usize,
+    limits: [f32; NUM_JOINTS],
+}
+
+/// `s(e)` and `s'(e)` of the smoothed hinge.
+fn hinge(e: f32) -> (f32, f32) {
+    if e <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let n = (e * e + EPS * EPS).sqrt();
+    (n - EPS, e / n)
+}
+
+impl EnvelopeGuard {
+    /// For motions of `frames` frames; `people` motions make one sample's penalty.
+    pub fn new(frames: usize, people: usize, weight: f32) -> Self {
+        EnvelopeGuard {
+            weight,
+            frames,
+            people: people.max(1),
+            limits: ACCEL_LIMITS,
+        }
+    }
+
+    /// The penalty per sample of world joints `[B·P, N, 22, 3]`; adds its gradient with
+    /// respect to them to `grad`.
+    pub fn eval(&self, joints: &[f32], grad: &mut [f32]) -> Vec<f32> {
+        let per = self.frames * J3;
+        let motions = joints.len() / per.max(1);
+        let mut penalty = vec![0.0f32; motions / self.people];
+        if self.frames == 0 {
+            return penalty;
+        }
+        let floor_scale = self.weight / self.frames as f32;
+        let accel_scale = self.weight / self.frames.saturating_sub(2).max(1) as f32;
+        for m in 0..motions {
+            let motion = &joints[m * per..(m + 1) * per];
+            let g = &mut grad[m * per..(m + 1) * per];
+            let sample = m / self.people;
+            for t in 0..self.frames {
+                for j in 0..NUM_JOINTS {
+                    let k = t * J3 + 3 * j + 1;
+                    let (v, d) = hinge(-motion[k]);
+                    penalty[sample] += floor_scale * v;
+                    g[k] -= floor_scale * d;
+                }
+            }
+            for t in 0..self.frames {
+                for &(a, b, least) in &MIN_SPANS {
+                    let (ka, kb) = (t * J3 + 3 * a, t * J3 + 3 * b);
+                    let r: [f32; 3] = std::array::from_fn(|i| motion[ka + i] - motion[kb + i]);
+                    let size = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+                    let (v, d) = hinge(least - size);
+                    if v == 0.0 && d == 0.0 {
+                        continue;
+                    }
+                    penalty[sample] += floor_scale * v;
+                    // d/dJ_a of s(least − |J_a − J_b|) = −s' · r/|r|.
+                    let along = floor_scale * d / size.max(1e-9);
+                    for (i, ri) in r.iter().enumerate() {
+                        g[ka + i] -= along * ri;
+                        g[kb + i] += along * ri;
+                    }
+                }
+            }
+            for t in 1..self.frames.saturating_sub(1) {
+                for (j, limit) in self.limits.iter().enumerate() {
+                    let r: [f32; 3] = std::array::from_fn(|a| {
+                        let k = 3 * j + a;
+                        motion[(t + 1) * J3 + k] - 2.0 * motion[t * J3 + k]
+                            + motion[(t - 1) * J3 + k]
+                    });
+                    let size = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+                    let (v, d) = hinge(size - limit);
+                    if v == 0.0 && d == 0.0 {
+                        continue;
+                    }
+                    penalty[sample] += accel_scale * v;
+                    let along = accel_scale * d / size.max(1e-9);
+                    for (a, ra) in r.iter().enumerate() {
+                        let k = 3 * j + a;
+                        let dk = along * ra;
+                        g[(t + 1) * J3 + k] += dk;
+                        g[t * J3 + k] -= 2.0 * dk;
+                        g[(t - 1) * J3 + k] += dk;
+                    }
+                }
+            }
+        }
+        penalty
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `[1, N, 22, 3]` joints of the rest pose 10 cm up, moved along x by `x(t)`.
+    fn motion(x: impl Fn(usize) -> f32, frames: usize) -> Vec<f32> {
+        let mut v = Vec::with_capacity(frames * J3);
+        for t in 0..frames {
+            for p in crate::skeleton::rest_pose() {
+                v.extend([p.x + x(t), p.y + 0.1, p.z]);
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn a_real_motion_is_free_and_a_snap_or_the_floor_is_not() {
+        let frames = 12;
+        let guard = EnvelopeGuard::new(frames, 1, 1.0);
+        // A walk-like drift: 0.07 m per frame, no acceleration.
+        let walk = motion(|t| 0.07 * t as f32, frames);
+        let mut g = vec![0.0; walk.len()];
+        assert_eq!(guard.eval(&walk, &mut g), vec![0.0]);
+        assert!(g.iter().all(|&v| v == 0.0));
+        // The same with a 0.3 m jump at frame 6: over every joint's limit.
+        let snap = motion(|t| 0.07 * t as f32 + if t >= 6 { 0.3 } else { 0.0 }, frames);
+        let mut g = vec![0.0; snap.len()];
+        assert!(guard.eval(&snap, &mut g)[0] > 0.0);
+        // Descent (−gradient) pulls frame 6 back (−x) and frame 5 forward.
+        assert!(
+            g[6 * J3] > 0.0 && g[5 * J3] < 0.0,
+            "{} {}",
+            g[6 * J3],
+            g[5 * J3]
+        );
+        // A wrist 10 cm under the floor on one frame: pushed up there only.
+        let mut low = walk.clone();
+        low[3 * J3 + 3 * 20 + 1] = -0.1;
+        let mut g = vec![0.0; low.len()];
+        let p = guard.eval(&low, &mut g)[0];
+        assert!(p > 0.0);
+        assert!(g[3 * J3 + 3 * 20 + 1] < 0.0, "descent raises it");
+    }
+
+    #[test]
+    fn a_hunched_spine_costs_and_is_pushed_open() {
+        let frames = 3;
+        let guard = EnvelopeGuard::new(frames, 1, 1.0);
+        let mut pose = vec![0.0f32; frames * J3];
+        for t in 0..frames {
+            for (j, p) in crate::skeleton::rest_pose().iter().enumerate() {
+                let k = t * J3 + 3 * j;
+                pose[k..k + 3].copy_from_slice(&[p.x, p.y + 0.1, p.z]);
+            }
+        }
+        let mut g = vec![0.0; pose.len()];
+        assert_eq!(
+            guard.eval(&pose, &mut g),
+            vec![0.0],
+            "the rest pose is inside"
+        );
+        // Spine3 pulled down to 0.2 m above the pelvis on the middle frame.
+        let k = J3 + 3 * 9 + 1;
+        pose[k] = pose[J3 + 1] + 0.2;
+        let mut g = vec![0.0; pose.len()];
+        assert!(guard.eval(&pose, &mut g)[0] > 0.0);
+        assert!(g[k] < 0.0, "descent lifts spine3 back up");
+    }
+
+    #[test]
+    fn gradient_matches_finite_differences() {
+        let frames = 7;
+        let guard = EnvelopeGuard::new(frames, 2, 0.7);
+        let mut x: Vec<f32> = (0..2 * frames * J3)
+            .map(|i| 0.3 * (0.71 * i as f32).sin())
+            .collect();
+        // Some joints below the floor, some fast.
+        for (i, v) in x.iter_mut().enumerate() {
+            if i % 3 == 1 {
+                *v += 0.2;
+            }
+        }
+        let mut g = vec![0.0; x.len()];
+        guard.eval(&x, &mut g);
+        let f = |x: &[f32]| -> f64 {
+            let mut scratch = vec![0.0; x.len()];
+            guard.eval(x, &mut scratch).iter().map(|&v| v as f64).sum()
+        };
+        let eps = 1e-3;
+        for i in (0..x.len()).step_by(5) {
+            let (mut a, mut b) = (x.clone(), x.clone());
+            a[i] += eps;
+            b[i] -= eps;
+            let fd = (f(&a) - f(&b)) / (2.0 * eps as f64);
+            assert!(
+                (fd - g[i] as f64).abs() < 2e-2 * (1.0 + fd.abs()),
+                "coordinate {i}: analytic {} vs numeric {fd}",
+                g[i]
+            );
+        }
+    }
+}
