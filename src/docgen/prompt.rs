@@ -433,6 +433,19 @@ const RULES: &str = r#"
 11. If mprog answers with diagnostics (JSON from `mprog check --format json`), fix exactly
    the reported problems (each has a code, a line, a message and a hint) and answer with
    the whole corrected program.
+12. Say the sentence's words in the forms that mean them:
+    - **Speed over the ground** is `speed(projToGround(pelvis))`: `speed(pelvis) > 1.7`
+      is met by the pelvis bouncing up and down on the spot.
+    - **Which way a turn goes** is the sign of `cross(facing(), vel(facing())).y`, the
+      turning rate in rad/s (positive: to the left, counter-clockwise seen from above):
+      `during 0s..end - 1 { cross(facing(), vel(facing())).y > 0.5 }` turns left; keyframes
+      of `facing()` alone leave the direction to chance.
+    - **People who touch must not pass through each other**: beside a contact, keep their
+      torsos apart (`always { noTorsoCollision(a, b, 12 cm) }` for a hug or a hand-over,
+      `separation(a, b, 0.5 m)` for people who only meet hands).
+    - **Directions of the body's own** ("arms out to the sides", "lie on the back") are
+      `bodyLeft()`, `bodyFront()`, `bodyUp()`, not world axes, which stop being the body's
+      once it turns.
 "#;
 
 #[cfg(test)]
@@ -470,6 +483,9 @@ mod tests {
             "length 4s\nalways { dot(normalize(l_hand - l_shoulder), bodyLeft()) > 0.9\n dot(normalize(r_hand - r_shoulder), bodyLeft()) < -0.9 }\n",
             "length 4s\nat end { dot(gaze(), [1, 0, 0]) > 0.7 }\nat 1s { head.y < 1.2 m + 0.1 m/s * time@2s }\n",
             "length 4s\nduring end - 0.5s..end + 1 { pelvis.y < 0.5 m }\nalways { speed(pelvis) < 1.5 m/s }\n",
+            // Rule 12's forms: ground speed, turn direction, torsos apart.
+            "length 4s\nalways { speed(projToGround(pelvis)) > 1.7 }\nduring 0s..end - 1 { cross(facing(), vel(facing())).y > 0.5 }\n",
+            "length 6s\npeople a \"x\", b \"y\"\nspacing 1 m\nduring 3s..end + 1 { contact(a.l_hand, b.spine3, 15 cm) }\nalways { noTorsoCollision(a, b, 12 cm) }\n",
         ] {
             let d = crate::lang::check_source(src, "t.mprog", &[]);
             assert!(!d.has_errors(), "{src}\n{}", d.render_plain());
