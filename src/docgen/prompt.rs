@@ -89,10 +89,12 @@ always {
         r#"prompt "a person raises both arms out to the sides and looks to the left"
 length 5s
 
-# `bodyLeft()` is the torso's own left: "out to the sides" wherever the body faces.
+# `bodyLeft()` is the torso's own left: "out to the sides" wherever the body faces. Keep
+# the torso upright, or leaning sideways would point the "sides" at the sky.
 during 1s..end + 1 {
     dot(normalize(l_hand - l_shoulder), bodyLeft()) > 0.9
     dot(normalize(r_hand - r_shoulder), bodyLeft()) < -0.9
+    dot(bodyUp(), [0, 1, 0]) > 0.95
 }
 # An end state, held over the last half second rather than on the last frame alone.
 during end - 0.5s..end + 1 { dot(gaze(), [1, 0, 0]) > 0.7 }
@@ -348,7 +350,9 @@ minimize norm(acc(r_hand))             # any scalar
 - The body's own axes follow the torso, wherever it faces or lies: `bodyLeft()`,
   `bodyUp()` (pelvis to neck) and `bodyFront()`; arms out to the sides are
   `dot(normalize(l_hand - l_shoulder), bodyLeft()) > 0.9` and
-  `dot(normalize(r_hand - r_shoulder), bodyLeft()) < -0.9`. `gaze()` is where the head
+  `dot(normalize(r_hand - r_shoulder), bodyLeft()) < -0.9`, with the torso kept upright
+  (`dot(bodyUp(), [0, 1, 0]) > 0.95`): else the body meets them by leaning sideways, which
+  points its "left" up. `gaze()` is where the head
   faces as far as joints show it (the shoulders' turn and the head's tip forward or back;
   the head turning on its own neck is not seen): looking left is `dot(gaze(), [1, 0, 0]) > 0.7`.
 - A function sees its arguments, the `param`s, and the `let`s written above it.

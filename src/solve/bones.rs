@@ -16,7 +16,8 @@
 //!    BVH cannot carry;
 //! 2. on frames where a foot joint touched the floor (below [`CONTACT_HEIGHT`]) when the
 //!    projection was set up, shifts the body vertically so that its lowest foot joint is
-//!    at that height: the body stands on its lowest foot, whichever that is now;
+//!    at that height, or on the floor if it was below it: the body stands on its lowest
+//!    foot, whichever that is now;
 //! 3. shifts the frames between such frames (a step's swing, a jump) by the shifts of the
 //!    planted frames on either side, linearly interpolated over time (the nearest one's
 //!    before the first and after the last). Shifting only the planted frames moved the
@@ -104,7 +105,10 @@ impl SkeletonProjection {
             .chunks_exact(HEAD)
             .map(|row| {
                 let (_, y) = lowest_foot(|j| joint(row, j)[1]);
-                (y < CONTACT_HEIGHT).then_some(y)
+                // A planted foot stands on the floor, not in it: an anchor below y = 0 would
+                // hold it there against the envelope's floor term (an ankle 5 cm under the
+                // floor on 12 to 31 frames of the trial's standing tasks).
+                (y < CONTACT_HEIGHT).then_some(y.max(0.0))
             })
             .collect();
         let rows = anchors.len();
@@ -415,6 +419,20 @@ mod tests {
                 g[i]
             );
         }
+    }
+
+    #[test]
+    fn a_foot_planted_under_the_floor_is_stood_on_the_floor() {
+        let sunk = lifted(rest(), -0.05);
+        let mut p = SkeletonProjection::new(&sunk, 1);
+        assert_eq!(p.anchored(), 1);
+        let mut out = vec![0.0; HEAD];
+        p.forward(&sunk, &mut out);
+        let lowest = [7, 8, 10, 11]
+            .map(|j| joint(&out, j)[1])
+            .into_iter()
+            .fold(f32::INFINITY, f32::min);
+        assert!(lowest.abs() < 1e-5, "lowest foot joint at {lowest}");
     }
 
     #[test]
