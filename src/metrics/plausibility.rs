@@ -35,10 +35,11 @@ pub const SKATING_MARGIN: f32 = 1.0;
 pub const RIGID_SLACK: f32 = 0.15;
 /// Largest angle (degrees) between the hip line and the collar line: the torso twisted
 /// about the spine. In `data/combined` it is 7° at the median, 40° at the 99.9th
-/// percentile of frames and 59° at the 99.99th (a few frames of capture glitches reach
-/// 125°); flagged past that by 15°, the rigid parts' slack. A late guidance step once
-/// turned the shoulder girdle 180° on the hips, which no distance check saw.
-pub const TORSO_TWIST_DEG: f32 = 75.0;
+/// percentile of frames and 59° at the 99.99th; CMU's ballet (05_06, a cartwheel, and the
+/// leap 05_16) reach 89° and 125°, so the check sits above every recorded frame. A late
+/// guidance step once turned the shoulder girdle 180° on the hips, which no distance
+/// check saw.
+pub const TORSO_TWIST_DEG: f32 = 130.0;
 /// Pelvis speed (m/s) above which the direction of travel is compared with the facing.
 pub const FACING_SPEED: f32 = 0.5;
 /// Angle (degrees) between travel and facing above which a person walks backwards.
@@ -679,7 +680,8 @@ fn twist_check(m: &Motion, out: &mut Vec<Problem>) {
         p.value = twist[s..=e].iter().copied().fold(0.0, f32::max);
         p.limit = TORSO_TWIST_DEG;
         p.unit = "°".into();
-        p.against = "real clips: 40° at the 99.9th percentile of frames, 59° at the 99.99th".into();
+        p.against =
+            "real clips: 40° at the 99.9th percentile of frames, 125° at most (ballet)".into();
         out.push(p);
     }
 }
