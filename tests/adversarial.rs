@@ -1421,3 +1421,48 @@ fn dataset_with_corrupt_clip_offsets_is_refused() {
     });
     assert_mentions(&m, &["clips.json", "offset"]);
 }
+
+/// `check` warns of every prompt `run` would (issue 53): one the model reads through its
+/// nearest captions (best cosine 0.5–0.7), one far from every caption, and none for a
+/// paraphrase of a caption it knows. Needs the shipped sentence-encoder model.
+#[test]
+fn check_warns_of_every_prompt_run_would() {
+    let dir = tempfile::tempdir().unwrap();
+    let program =
+        |prompt: &str| format!("prompt \"{prompt}\"\nlength 4s\nalways {{ r_hand.y > 1 m }}\n");
+    for (file, prompt) in [
+        ("snapped.mprog", "a person claps above the head"),
+        ("far.mprog", "a person plays the violin"),
+        ("near.mprog", "someone strolls ahead"),
+    ] {
+        std::fs::write(dir.path().join(file), program(prompt)).unwrap();
+    }
+    let json = |file: &str| -> serde_json::Value {
+        let out = mprog(dir.path(), &["check", file, "--format", "json"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let far_prompts = |v: &serde_json::Value| -> Vec<String> {
+        let items = v.as_array().map_or_else(|| vec![v.clone()], |a| a.clone());
+        items
+            .iter()
+            .flat_map(|f| f["diagnostics"].as_array().cloned().unwrap_or_default())
+            .filter(|d| d["code"] == "mprog::far_prompt")
+            .map(|d| d["hint"].as_str().unwrap_or_default().to_string())
+            .collect()
+    };
+    let snapped = far_prompts(&json("snapped.mprog"));
+    assert_eq!(snapped.len(), 1, "{snapped:?}");
+    assert!(
+        snapped[0].contains("conditioned on the mean of its nearest captions"),
+        "{snapped:?}"
+    );
+    let far = far_prompts(&json("far.mprog"));
+    assert_eq!(far.len(), 1, "{far:?}");
+    assert!(far[0].contains("nearest known:"), "{far:?}");
+    assert!(far_prompts(&json("near.mprog")).is_empty());
+}
