@@ -88,6 +88,17 @@ pub const BONE_LENGTHS: [f32; NUM_JOINTS] = [
     0.26988,
 ];
 
+/// The body's parts, each with its joints: what an edit holds or frees as a whole and what
+/// the plausibility report groups joints by.
+pub const BODY_PARTS: [(&str, &[usize]); 6] = [
+    ("torso", &[0, 3, 6, 9]),
+    ("head", &[12, 15]),
+    ("left arm", &[13, 16, 18, 20]),
+    ("right arm", &[14, 17, 19, 21]),
+    ("left leg", &[1, 4, 7, 10]),
+    ("right leg", &[2, 5, 8, 11]),
+];
+
 /// Height of the pelvis above the floor in HumanML3D's rest pose (metres).
 pub const REST_PELVIS_HEIGHT: f32 = 0.837;
 

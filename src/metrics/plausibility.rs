@@ -138,16 +138,6 @@ pub const CAPSULES: [Capsule; 8] = [
     },
 ];
 
-/// Body parts the joint checks are grouped by.
-const PARTS: [(&str, &[usize]); 6] = [
-    ("torso", &[0, 3, 6, 9]),
-    ("head", &[12, 15]),
-    ("left arm", &[13, 16, 18, 20]),
-    ("right arm", &[14, 17, 19, 21]),
-    ("left leg", &[1, 4, 7, 10]),
-    ("right leg", &[2, 5, 8, 11]),
-];
-
 /// What is wrong.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -543,7 +533,7 @@ fn joint_checks(m: &Motion, env: &Envelope, out: &mut Vec<Problem>) {
         range,
     } in checks
     {
-        for (part, joints) in PARTS {
+        for (part, joints) in crate::skeleton::BODY_PARTS {
             let mut flags = vec![false; n];
             // (ratio to limit, value, joint) of the worst joint at each frame.
             let mut worst = vec![(0.0f32, 0.0f32, 0usize); n];

@@ -44,8 +44,15 @@ pub struct AccelHold {
 }
 
 /// `J[t+1] − 2·J[t] + J[t−1]` of coordinate `k` of a `[N, 22, 3]` motion, `t` the middle.
-fn second_difference(motion: &[f32], t: usize, k: usize) -> f32 {
+pub(super) fn second_difference(motion: &[f32], t: usize, k: usize) -> f32 {
     motion[(t + 1) * J3 + k] - 2.0 * motion[t * J3 + k] + motion[(t - 1) * J3 + k]
+}
+
+/// Adds `d` times the gradient of [`second_difference`]`(·, t, k)` to `grad`.
+pub(super) fn add_second_difference_grad(grad: &mut [f32], t: usize, k: usize, d: f32) {
+    grad[(t + 1) * J3 + k] += d;
+    grad[t * J3 + k] -= 2.0 * d;
+    grad[(t - 1) * J3 + k] += d;
 }
 
 impl AccelHold {
@@ -97,11 +104,7 @@ impl AccelHold {
                     // d/dr of √(e² + ε²) with e = |r| − tol: e/√(e² + ε²) · r/|r|.
                     let along = scale * excess / (norm * size);
                     for (a, ra) in r.iter().enumerate() {
-                        let k = 3 * j + a;
-                        let d = along * ra;
-                        g[(t + 1) * J3 + k] += d;
-                        g[t * J3 + k] -= 2.0 * d;
-                        g[(t - 1) * J3 + k] += d;
+                        add_second_difference_grad(g, t, 3 * j + a, along * ra);
                     }
                 }
             }

@@ -85,14 +85,7 @@ pub const RESAMPLE_JUMP: usize = 10;
 const LEG_JOINTS: [usize; 8] = [1, 4, 7, 10, 2, 5, 8, 11];
 
 /// The body parts [`auto_hold`] holds or frees as a whole, with their joints.
-pub const BODY_PARTS: [(&str, &[usize]); 6] = [
-    ("torso", &[0, 3, 6, 9]),
-    ("head", &[12, 15]),
-    ("left arm", &[13, 16, 18, 20]),
-    ("right arm", &[14, 17, 19, 21]),
-    ("left leg", &[1, 4, 7, 10]),
-    ("right leg", &[2, 5, 8, 11]),
-];
+pub use crate::skeleton::BODY_PARTS;
 
 /// Path columns of a feature row: turning speed and horizontal velocity. Not the root
 /// height: the other joints' heights are the edited body's, and the take's pelvis height

@@ -22,6 +22,7 @@
 //! `w · (Σ_{t,j} s(|Δ²J_tj| − a_j) / (N − 2) + Σ_{t,j} s(−y_tj) / N + Σ_{t,(a,b)} s(d_ab − |J_ta − J_tb|) / N)` with
 //! `s(e) = √(e² + ε²) − ε` for `e > 0` (0 otherwise), in metres like the program's error.
 
+use super::accel::{add_second_difference_grad, second_difference};
 use crate::skeleton::NUM_JOINTS;
 
 /// Smoothing of the hinge at zero (m or m/frame²).
@@ -160,11 +161,8 @@ impl EnvelopeGuard {
             }
             for t in 1..self.frames.saturating_sub(1) {
                 for (j, limit) in self.limits.iter().enumerate() {
-                    let r: [f32; 3] = std::array::from_fn(|a| {
-                        let k = 3 * j + a;
-                        motion[(t + 1) * J3 + k] - 2.0 * motion[t * J3 + k]
-                            + motion[(t - 1) * J3 + k]
-                    });
+                    let r: [f32; 3] =
+                        std::array::from_fn(|a| second_difference(motion, t, 3 * j + a));
                     let size = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
                     let (v, d) = hinge(size - limit);
                     if v == 0.0 && d == 0.0 {
@@ -173,11 +171,7 @@ impl EnvelopeGuard {
                     penalty[sample] += accel_scale * v;
                     let along = accel_scale * d / size.max(1e-9);
                     for (a, ra) in r.iter().enumerate() {
-                        let k = 3 * j + a;
-                        let dk = along * ra;
-                        g[(t + 1) * J3 + k] += dk;
-                        g[t * J3 + k] -= 2.0 * dk;
-                        g[(t - 1) * J3 + k] += dk;
+                        add_second_difference_grad(g, t, 3 * j + a, along * ra);
                     }
                 }
             }
