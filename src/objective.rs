@@ -20,6 +20,29 @@ pub trait MotionError {
     fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
         self.error(joints).unsqueeze_dim(1)
     }
+
+    /// [`Self::error`] counting only frames before `until`: a long motion is made window
+    /// by window, and frames from `until` on are placeholders not made yet. The default
+    /// counts every frame (an error with no notion of time).
+    fn error_until(&self, joints: Tensor<5>, until: usize) -> Tensor<1> {
+        let _ = until;
+        self.error(joints)
+    }
+
+    /// [`Self::terms`] counting only frames before `until` (see [`Self::error_until`]).
+    fn terms_until(&self, joints: Tensor<5>, until: usize) -> Tensor<2> {
+        let _ = until;
+        self.terms(joints)
+    }
+
+    /// Per frame of a motion of `frames` frames, whether the error reads it at all (a
+    /// statement's window, with the neighbours its velocities read), met or not; frames
+    /// it never reads are untouched time, which an edit of a take holds. `None` (the
+    /// default): every frame may count.
+    fn active_frames(&self, frames: usize) -> Option<Vec<bool>> {
+        let _ = frames;
+        None
+    }
 }
 
 impl<F: Fn(Tensor<5>) -> Tensor<1>> MotionError for F {

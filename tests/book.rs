@@ -195,8 +195,8 @@ fn prompt_examples_compile_and_cover_the_library() {
         .collect();
     assert_eq!(
         blocks.len(),
-        EXAMPLES.len() + 1,
-        "the language sketch and the worked examples"
+        EXAMPLES.len() + 2,
+        "the language sketch, the timeline and the worked examples"
     );
     assert_eq!(EXAMPLES.len(), 7);
     for b in &blocks {

@@ -132,6 +132,65 @@ fn kept_frames_come_back_and_the_rest_is_edited() {
 }
 
 #[test]
+fn untouched_time_is_held_unless_free_time() {
+    // WALK reads frames 20..39 of 40 (`during 50%..100%`): frames 0..10 are held, 10..20
+    // ease into the edit (the default margin, 10 frames).
+    let dir = tempfile::tempdir().unwrap();
+    let prog = program(dir.path(), WALK);
+    let (take_path, people) = take(dir.path(), "take.json", 41, 1);
+    let want = &Take::encode(&people).unwrap().motions().unwrap()[0];
+    let first = |m: &Motion| Motion::new(m.frames[..10].to_vec());
+    let edit = |extra: &[&str], name: &str| {
+        let out_path = dir.path().join(name);
+        let mut args = vec![
+            "run",
+            &prog,
+            "--from",
+            &take_path,
+            "--strength",
+            "1",
+            "--knob",
+            "steps=10",
+            "--knob",
+            "k_late=20",
+            "--knob",
+            "late_steps=2",
+            "--no-baseline",
+            "-o",
+            out_path.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let out = run(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let (got, meta) = people_of(&out_path);
+        (got.into_iter().next().unwrap(), meta, stderr(&out))
+    };
+    let (held, meta, err) = edit(&[], "held.json");
+    assert!(
+        err.contains("untouched time held to the take: frames 0..10 (0.00–0.50 s) of 40")
+            && err.contains("the 10 frames (0.50 s)"),
+        "{err}"
+    );
+    let gap = max_joint_error(&first(&held), &first(want));
+    assert!(gap < 0.02, "untouched time moved {gap} m");
+    let e = meta["edit"].as_object().unwrap();
+    assert_eq!(e["held_time"], serde_json::json!([[0, 10]]));
+    assert_eq!(e["time_margin"], 10);
+    // `--free-time`: every frame is the edit's again, as before untouched time was held.
+    let (free, meta, err) = edit(&["--free-time"], "free.json");
+    assert!(err.contains("every frame free"), "{err}");
+    let gap = max_joint_error(&first(&free), &first(want));
+    assert!(
+        gap > 0.02,
+        "with --free-time the first frames moved only {gap} m"
+    );
+    assert_eq!(meta["edit"]["held_time"], serde_json::json!([]));
+    // A wider margin holds fewer frames.
+    let (_, meta, _) = edit(&["--time-margin", "15"], "wide.json");
+    assert_eq!(meta["edit"]["held_time"], serde_json::json!([[0, 5]]));
+}
+
+#[test]
 fn bad_takes_windows_and_strengths_are_clear_errors_with_no_output() {
     let dir = tempfile::tempdir().unwrap();
     let prog = program(dir.path(), WALK);

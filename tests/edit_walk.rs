@@ -8,6 +8,10 @@
 //!   left hand within 15 cm of the head for the second half", at several strengths and
 //!   with the first half kept: how far the root path moves from the take, the travelled
 //!   distance, how far the first half moves, and the program's error on the second half.
+//! * **Untouched time**: the same walk and program (the hand on the head from frame 70)
+//!   with the frames the program does not read held, at several margins, against
+//!   `--free-time`: how far the held frames and the first half move, the program's error,
+//!   and the accelerations around the seam against the take's own.
 //! * **An in-between** of two real clips (the end of that walk, the start of
 //!   `dataset-1_run_happy_001`): the largest frame-to-frame joint jump against the
 //!   clips' own, and foot skating against theirs.
@@ -24,13 +28,14 @@ use mprog::formats::{LoadedMotion, Meta, read_motion, write_motion};
 use mprog::lang::{Program, compile};
 use mprog::metrics::per_motion::{foot_skating_ratio, max_bone_error};
 use mprog::model::ModelBundle;
+use mprog::model::control::ControlNet;
 use mprog::model::sampler::SamplerKind;
 use mprog::model::weights::default_model_dir;
 use mprog::motion::Motion;
 use mprog::solve::take::frames_of;
 use mprog::solve::{
     DEFAULT_BLEND, DEFAULT_RESAMPLE, DEFAULT_STRENGTH, Edit, GuideConfig, LatentConfig, Prior,
-    SolveRequest, Solver, Take, auto_hold, hold_weights, in_between_hold, solve,
+    SolveRequest, Solver, TIME_MARGIN, Take, auto_hold, hold_weights, in_between_hold, solve,
 };
 use std::path::PathBuf;
 
@@ -93,7 +98,9 @@ enum Holds {
     None,
     /// The path (`--keep-path --free-body`).
     Path,
-    /// What `auto_hold` finds (the default of `mprog run --from`).
+    /// What `auto_hold` finds for the path and the body (the default of
+    /// `mprog run --from --free-time`; untouched time is measured by
+    /// `untouched_time_of_a_real_walk`).
     Auto,
 }
 
@@ -464,4 +471,151 @@ fn seam_jump(m: &Motion, t: usize) -> f32 {
         .flat_map(|u| (0..22).map(move |j| (u, j)))
         .map(|(u, j)| (m.frames[u + 1][j] - m.frames[u][j]).length())
         .fold(0.0, f32::max)
+}
+
+/// Largest acceleration `|p[t+1] − 2p[t] + p[t−1]|` of joint `j` (m/frame², 20 fps) over
+/// the frames `frames` (clipped to the motion's inner frames).
+fn max_accel(m: &Motion, j: usize, frames: std::ops::Range<usize>) -> f32 {
+    (frames.start.max(1)..frames.end.min(m.len() - 1))
+        .map(|t| (m.frames[t + 1][j] - 2.0 * m.frames[t][j] + m.frames[t - 1][j]).length())
+        .fold(0.0, f32::max)
+}
+
+/// The largest distance of any of `joints` from the take's over `frames`.
+fn joint_gap(a: &Motion, b: &Motion, frames: std::ops::Range<usize>, joints: &[usize]) -> f32 {
+    frames
+        .flat_map(|t| {
+            joints
+                .iter()
+                .map(move |&j| (a.frames[t][j] - b.frames[t][j]).length())
+        })
+        .fold(0.0, f32::max)
+}
+
+#[test]
+#[ignore = "minutes with the shipped model: cargo test --release --test edit_walk -- --ignored --nocapture untouched_time"]
+fn untouched_time_of_a_real_walk() {
+    let Some(walk) = bandai(WALK) else { return };
+    let dir = default_model_dir();
+    let device = Device::flex();
+    let bundle = ModelBundle::load(&dir, &device).unwrap();
+    // As `mprog run` does: the realism ControlNet beside the weights steers `guide`.
+    let control =
+        ControlNet::load(&dir, &bundle.model, bundle.manifest.half_precision, &device).unwrap();
+    let take = Take::encode(std::slice::from_ref(&walk)).unwrap();
+    let n = take.frames;
+    let source = format!(
+        "prompt \"a happy person walks forward\"\nlength {n} frames\nduring 50%..end + 1 {{ dist(l_hand, head) < 15 cm }}\n"
+    );
+    let program = compile(&source, "hand_on_head_second_half.mprog", &[]).unwrap();
+    let retargeted = take.motions().unwrap().remove(0);
+    let auto = auto_hold(&take, &program, &device).unwrap();
+    let seam = auto.untouched.iter().position(|u| !u).unwrap();
+    println!(
+        "the program reads frames {seam}..{n}; parts held: {:?}",
+        auto.parts
+    );
+    let all: Vec<usize> = (0..22).collect();
+    // (label, hold weights)
+    let mut runs: Vec<(String, Vec<f32>)> = vec![("--free-time".into(), vec![])];
+    for margin in [5, 10, 15, 20] {
+        runs.push((
+            format!(
+                "held, margin {margin}{}",
+                if margin == TIME_MARGIN {
+                    " (the default)"
+                } else {
+                    ""
+                }
+            ),
+            auto.time_weights(margin),
+        ));
+    }
+    runs.push((
+        format!("held to frame {seam}, the {TIME_MARGIN}-frame blend inside the window"),
+        hold_weights(n, &[0..seam], TIME_MARGIN),
+    ));
+    println!(
+        "| run | first half (0..{seam}): largest joint gap (m) | pelvis | frames held exactly: largest joint gap | program error, 2nd half (m) | largest hand–head, 2nd half (m) | pelvis accel ±10 of {seam} (m/frame²) | head | left wrist | largest bone error (m) |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    let around = seam - 10..seam + 11;
+    let hand_head = |m: &Motion| {
+        (seam..n)
+            .map(|t| (m.frames[t][20] - m.frames[t][15]).length())
+            .fold(0.0, f32::max)
+    };
+    println!(
+        "| the take | 0 | 0 | 0 | {:.4} | {:.3} | {:.4} ({:.4} in the whole take) | {:.4} ({:.4}) | {:.4} ({:.4}) | 0 |",
+        measure("", &retargeted, &retargeted, &program).program,
+        hand_head(&retargeted),
+        max_accel(&retargeted, 0, around.clone()),
+        max_accel(&retargeted, 0, 0..n),
+        max_accel(&retargeted, 15, around.clone()),
+        max_accel(&retargeted, 15, 0..n),
+        max_accel(&retargeted, 20, around.clone()),
+        max_accel(&retargeted, 20, 0..n),
+    );
+    let mut at_default = None;
+    for (i, (label, hold)) in runs.into_iter().enumerate() {
+        let exact = hold.iter().take_while(|w| **w >= 1.0).count();
+        let e = Edit {
+            take: take.clone(),
+            strength: DEFAULT_STRENGTH,
+            hold,
+            hold_path: auto.path,
+            hold_joints: auto.joints(),
+            resample: 0,
+            clean_feet: true,
+        };
+        let req = SolveRequest::new(
+            vec!["a happy person walks forward".into()],
+            n,
+            1,
+            Solver::new(GuideConfig::default()),
+        )
+        .editing(e);
+        let out = solve(
+            &Prior::from_bundle(&bundle).with_control(control.as_ref()),
+            &req,
+            &program,
+            &device,
+            |_| {},
+        )
+        .expect("the edit runs");
+        let m = out.motions[0][0].clone();
+        save(&format!("untouched_time_{i}"), std::slice::from_ref(&m));
+        let r = measure("", &retargeted, &m, &program);
+        let held = joint_gap(&m, &retargeted, 0..exact, &all);
+        println!(
+            "| {label} (untouched_time_{i}) | {:.3} | {:.3} | {} | {:.4} | {:.3} | {:.4} | {:.4} | {:.4} | {:.3} |",
+            joint_gap(&m, &retargeted, 0..seam, &all),
+            joint_gap(&m, &retargeted, 0..seam, &[0]),
+            if exact == 0 {
+                "—".into()
+            } else {
+                format!("{held:.4} (0..{exact})")
+            },
+            r.program,
+            hand_head(&m),
+            max_accel(&m, 0, around.clone()),
+            max_accel(&m, 15, around.clone()),
+            max_accel(&m, 20, around.clone()),
+            r.bone,
+        );
+        if label.ends_with("(the default)") {
+            at_default = Some((held, r.program, max_accel(&m, 20, around.clone())));
+        }
+    }
+    let (held, program_error, wrist) = at_default.expect("the default margin is measured");
+    assert!(held <= 0.02, "held untouched time moved {held:.3} m");
+    assert!(
+        program_error <= 0.01,
+        "second half: program error {program_error:.4} m"
+    );
+    let own = max_accel(&retargeted, 20, 0..n);
+    assert!(
+        wrist <= 1.5 * own,
+        "the wrist pops at the seam: {wrist:.3} m/frame² against the take's largest {own:.3}"
+    );
 }

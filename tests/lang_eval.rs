@@ -742,3 +742,54 @@ fn wrong_shapes_are_reported_not_panicking() {
     let x = burn::tensor::Tensor::<5>::zeros([1, 1, F, 21, 3], &dev);
     assert!(prog.try_evaluate(x).is_err());
 }
+
+#[test]
+fn a_window_counts_only_the_frames_made_so_far() {
+    use burn::prelude::*;
+    use mprog::solve::MotionError;
+    // Head 1 m too low on every frame: 1 m of error for `always`, for `at 30`, and for
+    // `during 10..40`, on a motion of 60 frames.
+    const N: usize = 60;
+    let prog = program(&format!(
+        "length {N} frames\nalways {{ head.y > 2.5 m }}\nat 30 {{ head.y > 2.5 m }}\nduring 10..40 {{ head.y > 2.5 m }}\n"
+    ));
+    let m: Motion = vec![(0..N).map(|_| standing()).collect()];
+    let (data, shape) = flat(&m);
+    let joints = || Tensor::<5>::from_data(TensorData::new(data.clone(), shape), &Device::flex());
+    let terms = |until: usize| -> Vec<f32> {
+        prog.terms_until(joints(), until)
+            .into_data()
+            .try_into_vec::<f32>()
+            .unwrap()
+    };
+    let full = terms(N);
+    let whole = prog
+        .terms(joints())
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap();
+    assert_eq!(full, whole, "until the end is the plain evaluation");
+    // Before frame 20: `always` counts frames 0..20 (the same mean), `at 30` nothing, the
+    // `during` its frames 10..20 (the same mean again).
+    let before = terms(20);
+    assert!((before[0] - full[0]).abs() < 1e-5 && (before[2] - full[2]).abs() < 1e-5);
+    assert_eq!(before[1], 0.0);
+    assert!(full[1] > 0.9);
+    // Before frame 5 the `during` has no frame yet.
+    assert_eq!(terms(5)[2], 0.0);
+    // The error counts only those frames: raising the head after frame 20 changes nothing.
+    let mut raised = m.clone();
+    for pose in &mut raised[0][20..] {
+        for j in pose.iter_mut() {
+            j[1] += 3.0;
+        }
+    }
+    let (data2, _) = flat(&raised);
+    let t2 = Tensor::<5>::from_data(TensorData::new(data2, shape), &Device::flex());
+    let after: Vec<f32> = prog
+        .terms_until(t2, 20)
+        .into_data()
+        .try_into_vec::<f32>()
+        .unwrap();
+    assert_eq!(after, before);
+}

@@ -61,6 +61,14 @@ pub struct GenArgs {
     /// caption (by default such a prompt is replaced by the mean of its nearest captions).
     #[arg(long)]
     literal_prompt: bool,
+    /// Motions longer than the model makes are made in windows: seconds each window keeps
+    /// from the one before.
+    #[arg(long, default_value_t = mprog::solve::long::DEFAULT_CONTEXT as f32 / 20.0)]
+    seam_context: f32,
+    /// RePaint resampling rounds of each window after the first (each round costs about
+    /// one more chain).
+    #[arg(long, default_value_t = mprog::solve::long::DEFAULT_WINDOW_RESAMPLE)]
+    seam_resample: usize,
     /// Exit non-zero when a motion's plausibility report finds a problem (a snap, the
     /// floor, foot skating, a deformed body, walking backwards); every motion is written
     /// all the same, with its report in the meta.
@@ -85,6 +93,28 @@ pub(super) fn seconds_to_frames(seconds: f32) -> Result<usize> {
     }
 }
 
+/// `--seam-context` in frames: at least one frame.
+pub(super) fn seam_context_frames(seconds: f32) -> Result<usize> {
+    if seconds.is_finite() && seconds >= 0.05 {
+        Ok((seconds * 20.0).round() as usize)
+    } else {
+        Err(miette::miette!(
+            help = "give a context such as --seam-context 1",
+            "--seam-context must be at least one frame (0.05 s), got {seconds}"
+        ))
+    }
+}
+
+/// The windows of a long motion as `[start, cut, end]` frames, for the meta.
+pub(super) fn windows_meta(windows: &[mprog::solve::long::Window]) -> serde_json::Value {
+    serde_json::json!(
+        windows
+            .iter()
+            .map(|w| [w.start, w.cut, w.end])
+            .collect::<Vec<_>>()
+    )
+}
+
 /// Parses `--sampler`/`--steps`.
 pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
     match name {
@@ -95,6 +125,70 @@ pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
             "unknown sampler `{other}`"
         )),
     }
+}
+
+/// A `gen` longer than the model makes: the unguided chain window by window
+/// ([`mprog::solve::long`]), each window continuing the last second of the one before.
+fn generate_long(
+    bundle: &ModelBundle,
+    args: &GenArgs,
+    frames: usize,
+    sampler: SamplerKind,
+    device: &burn::prelude::Device,
+    bar: &ProgressBar,
+    interrupt: &Interrupt,
+) -> Result<mprog::model::generate::Generated> {
+    use mprog::solve::long::{LongProgress, LongRequest, solve_long};
+    if args.mirror_average {
+        return Err(miette::miette!(
+            help = format!(
+                "drop --mirror-average, or ask for at most {:.1} s",
+                bundle.config.max_frames as f32 / 20.0
+            ),
+            "--mirror-average is not available for motions made in windows"
+        ));
+    }
+    let req = LongRequest {
+        samples: args.count.max(1),
+        guidance_scale: args.guidance,
+        clean_feet: !args.raw,
+        context: seam_context_frames(args.seam_context)?,
+        resample: args.seam_resample,
+        ..LongRequest::new(
+            vec![args.text.clone()],
+            frames,
+            args.seed,
+            mprog::solve::Solver::plain(sampler),
+        )
+    };
+    let nothing =
+        |j: burn::tensor::Tensor<5>| burn::tensor::Tensor::<1>::zeros([j.dims()[0]], &j.device());
+    let out = solve_long(
+        &mprog::solve::Prior::from_bundle(bundle),
+        &req,
+        &nothing,
+        device,
+        |p: LongProgress| {
+            if interrupt.is_requested() {
+                bar.finish_and_clear();
+                eprintln!(
+                    "interrupted in window {} of {}: nothing was written",
+                    p.window + 1,
+                    p.windows
+                );
+                std::process::exit(130);
+            }
+            let (done, total) = p.overall();
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        },
+    )
+    .into_diagnostic()?;
+    Ok(mprog::model::generate::Generated {
+        motions: out.motions.into_iter().flatten().collect(),
+        features: out.features,
+        unknown_words: out.unknown_words,
+    })
 }
 
 /// Runs `mprog gen`.
@@ -151,16 +245,41 @@ pub fn run(args: GenArgs) -> Result<()> {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     };
-    let mut out = match generate_interruptible(&bundle, &req, &device, progress, &interrupt) {
-        Err(e @ GenerateError::Interrupted { .. }) => {
-            bar.finish_and_clear();
-            eprintln!("{e}");
-            std::process::exit(130);
+    if frames > mprog::lang::check::MAX_LENGTH {
+        return Err(miette::miette!(
+            help = format!("ask for at most {} s", mprog::lang::check::MAX_LENGTH / 20),
+            "{frames} frames asked ({:.0} s); the longest motion mprog makes is {} frames",
+            frames as f32 / 20.0,
+            mprog::lang::check::MAX_LENGTH
+        ));
+    }
+    let long = frames > bundle.config.max_frames;
+    let mut out = if long {
+        generate_long(&bundle, &args, frames, sampler, &device, &bar, &interrupt)?
+    } else {
+        match generate_interruptible(&bundle, &req, &device, progress, &interrupt) {
+            Err(e @ GenerateError::Interrupted { .. }) => {
+                bar.finish_and_clear();
+                eprintln!("{e}");
+                std::process::exit(130);
+            }
+            other => other.into_diagnostic()?,
         }
-        other => other.into_diagnostic()?,
     };
     bar.finish_and_clear();
-    if !args.raw {
+    if long {
+        eprintln!(
+            "{:.1} s made in windows of at most {:.1} s, each keeping {:.1} s of the one before{}",
+            frames as f32 / 20.0,
+            bundle.config.max_frames as f32 / 20.0,
+            mprog::solve::long::DEFAULT_CONTEXT as f32 / 20.0,
+            if args.raw {
+                ""
+            } else {
+                "; feet cleaned in every window (--raw skips it)"
+            }
+        );
+    } else if !args.raw {
         let report =
             clean_generated(&mut out, frames, &FootCleanup::default()).into_diagnostic()?;
         eprintln!(
@@ -179,6 +298,21 @@ pub fn run(args: GenArgs) -> Result<()> {
     meta.insert("sampler".into(), format!("{sampler:?}").into());
     meta.insert("guidance_scale".into(), (args.guidance as f64).into());
     meta.insert("foot_cleanup".into(), (!args.raw).into());
+    if long {
+        let windows = mprog::solve::long::plan_windows(
+            &[vec![mprog::solve::long::PromptSpan {
+                from: 0,
+                to: frames,
+                prompt: args.text.clone(),
+            }]],
+            frames,
+            bundle.config.max_frames,
+            seam_context_frames(args.seam_context)?,
+        )
+        .into_diagnostic()?;
+        meta.insert("windows".into(), windows_meta(&windows));
+        meta.insert("seam_resample".into(), args.seam_resample.into());
+    }
     if let Some(snapped) = bundle.text.snapped(&args.text) {
         meta.insert("conditioned_on".into(), snapped.neighbours.into());
     }

@@ -13,6 +13,7 @@ use mprog::model::ModelBundle;
 use mprog::model::control::ControlNet;
 use mprog::model::weights::default_model_dir;
 use mprog::motion::Motion;
+use mprog::solve::long::{LongProgress, LongRequest, PromptSpan, solve_long};
 use mprog::solve::{Prior, Progress, SolveRequest, SolveResult, Solver, solve};
 use std::path::PathBuf;
 
@@ -74,6 +75,14 @@ pub struct RunArgs {
     /// files written as JSON, for tools (`mprog mcp` reads it).
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Motions longer than the model makes, and prompt timelines, are made in windows:
+    /// seconds each window keeps from the one before.
+    #[arg(long, default_value_t = mprog::solve::long::DEFAULT_CONTEXT as f32 / 20.0)]
+    seam_context: f32,
+    /// RePaint resampling rounds of each window after the first (each round costs about
+    /// one more chain).
+    #[arg(long, default_value_t = mprog::solve::long::DEFAULT_WINDOW_RESAMPLE)]
+    seam_resample: usize,
     /// Exit non-zero when the plausibility report finds a problem (a snap, the floor,
     /// foot skating, people overlapping, a deformed body, walking backwards); the outputs
     /// are written all the same, with the report in their meta.
@@ -116,10 +125,40 @@ fn per_statement(program: &Program, people: &[Motion], device: &Device) -> Resul
         .map_err(|e| miette!("{e:?}"))
 }
 
+/// Each person's timeline for a request: the program's spans, or the one prompt (the
+/// program's or `--text`) over the whole motion.
+fn timelines_of(program: &Program, prompts: &[String], frames: usize) -> Vec<Vec<PromptSpan>> {
+    program
+        .timelines()
+        .into_iter()
+        .zip(prompts)
+        .map(|(line, prompt)| {
+            if line.is_empty() {
+                vec![PromptSpan {
+                    from: 0,
+                    to: frames,
+                    prompt: prompt.clone(),
+                }]
+            } else {
+                line.into_iter()
+                    .map(|t| PromptSpan {
+                        from: t.from,
+                        to: t.to,
+                        prompt: t.text,
+                    })
+                    .collect()
+            }
+        })
+        .collect()
+}
+
+/// Solves `req` with a progress bar; with `timelines`, window by window
+/// ([`mprog::solve::long`]), the request giving the length, seed, solver and placements.
 fn solve_with_bar(
     bundle: &ModelBundle,
     control: Option<&ControlNet>,
     req: &SolveRequest,
+    timelines: Option<(&[Vec<PromptSpan>], usize, usize)>,
     program: &Program,
     device: &Device,
     label: &str,
@@ -132,19 +171,36 @@ fn solve_with_bar(
         .expect("template"),
     );
     let error: &dyn mprog::solve::MotionError = program;
-    let out = solve(
-        &Prior::from_bundle(bundle).with_control(control),
-        req,
-        error,
-        device,
-        |p: Progress| {
+    let prior = Prior::from_bundle(bundle).with_control(control);
+    let out = match timelines {
+        None => solve(&prior, req, error, device, |p: Progress| {
             bar.set_length(p.total as u64);
             bar.set_position(p.done as u64);
             if let Some(e) = p.error {
                 bar.set_message(format!("error {e:.4}"));
             }
-        },
-    )
+        }),
+        Some((lines, context, resample)) => {
+            let long = LongRequest {
+                timelines: lines.to_vec(),
+                context,
+                resample,
+                placements: req.placements.clone(),
+                guidance_scale: req.guidance_scale,
+                ..LongRequest::new(Vec::new(), req.frames, req.seed, req.solver.clone())
+            };
+            solve_long(&prior, &long, error, device, |p: LongProgress| {
+                let (done, total) = p.overall();
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+                let e = p
+                    .step
+                    .error
+                    .map_or(String::new(), |e| format!(", error {e:.4}"));
+                bar.set_message(format!("window {}/{}{e}", p.window + 1, p.windows));
+            })
+        }
+    }
     .into_diagnostic()
     .wrap_err_with(|| format!("solver {}", req.solver.name()))?;
     bar.finish_and_clear();
@@ -207,6 +263,35 @@ pub fn run(args: RunArgs) -> Result<()> {
         .map(|p| p.edit(&bundle.mean, &program))
         .transpose()?;
     let frames = edit.as_ref().map_or(program.length(), |e| e.take.frames);
+    // Longer than the model makes, or prompts on a timeline: made in windows.
+    let timelines = timelines_of(&program, &prompts, frames);
+    let windowed = frames > bundle.config.max_frames || timelines.iter().any(|t| t.len() > 1);
+    if windowed && edit.is_some() {
+        return Err(miette!(
+            help = format!(
+                "edit a take of at most {:.1} s with a single prompt",
+                bundle.config.max_frames as f32 / 20.0
+            ),
+            "editing a take in windows (a take longer than the model makes, or a prompt timeline) is not supported"
+        ));
+    }
+    let context = super::generate::seam_context_frames(args.seam_context)?;
+    let windows = windowed.then_some((timelines.as_slice(), context, args.seam_resample));
+    let window_plan = if windowed {
+        let w =
+            mprog::solve::long::plan_windows(&timelines, frames, bundle.config.max_frames, context)
+                .into_diagnostic()?;
+        eprintln!(
+            "{:.1} s in {} windows of at most {:.1} s, each keeping {:.1} s of the one before",
+            frames as f32 / 20.0,
+            w.len(),
+            bundle.config.max_frames as f32 / 20.0,
+            context as f32 / 20.0
+        );
+        w
+    } else {
+        Vec::new()
+    };
     let request = |solver: Solver| {
         let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver)
             .placed(program.placements());
@@ -220,6 +305,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         &bundle,
         control.as_ref(),
         &req,
+        windows,
         &program,
         &device,
         solver.name(),
@@ -234,6 +320,7 @@ pub fn run(args: RunArgs) -> Result<()> {
             &bundle,
             control.as_ref(),
             &req,
+            windows,
             &program,
             &device,
             "unguided",
@@ -341,6 +428,22 @@ pub fn run(args: RunArgs) -> Result<()> {
         );
     }
     meta.insert("prompts".into(), serde_json::json!(prompts));
+    if windowed {
+        let lines: Vec<Vec<serde_json::Value>> = timelines
+            .iter()
+            .map(|line| {
+                line.iter()
+                    .map(|s| serde_json::json!({"from": s.from, "to": s.to, "prompt": s.prompt}))
+                    .collect()
+            })
+            .collect();
+        meta.insert("timeline".into(), serde_json::json!(lines));
+        meta.insert(
+            "windows".into(),
+            super::generate::windows_meta(&window_plan),
+        );
+        meta.insert("seam_resample".into(), args.seam_resample.into());
+    }
     if let Some(plan) = &plan {
         meta.insert("edit".into(), plan.meta.clone().into());
     }

@@ -13,8 +13,8 @@ use mprog::lang::Program;
 use mprog::motion::Motion;
 use mprog::solve::take::frames_of;
 use mprog::solve::{
-    DEFAULT_BLEND, DEFAULT_RESAMPLE, DEFAULT_STRENGTH, Edit, Take, auto_hold, hold_weights,
-    parts_joints,
+    DEFAULT_BLEND, DEFAULT_RESAMPLE, DEFAULT_STRENGTH, Edit, TIME_MARGIN, Take, auto_hold,
+    hold_weights, merge_holds, parts_joints,
 };
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -58,6 +58,15 @@ pub struct TakeArgs {
     /// so the gait and the planted feet, as they were.
     #[arg(long, requires = "from", conflicts_with = "to")]
     pub free_body: bool,
+    /// Let every frame change. By default the frames no statement reads (outside every
+    /// window of the program) keep the take's motion, easing into the edit over
+    /// `--time-margin` frames before the first frame the program reads and after its last.
+    #[arg(long, requires = "from", conflicts_with = "to")]
+    pub free_time: bool,
+    /// Frames of untouched time next to the program's windows that ease from the take into
+    /// the edit (they may change; the frames the program reads are free).
+    #[arg(long, requires = "from", conflicts_with_all = ["to", "free_time"], value_name = "FRAMES", default_value_t = TIME_MARGIN)]
+    pub time_margin: usize,
     /// RePaint resampling rounds at the seams of kept frames (default 5 when frames are kept
     /// or an in-between is made, 0 otherwise); each round reruns the chain's steps once.
     #[arg(long, requires = "from", value_name = "ROUNDS")]
@@ -146,6 +155,10 @@ pub struct TakePlan {
     pub keep_path: Option<bool>,
     /// Hold the body parts the program does not touch.
     pub hold_body: bool,
+    /// Hold the frames no statement reads (not for an in-between: its gap is no take).
+    pub hold_time: bool,
+    /// Frames of untouched time that ease into the edit at each seam.
+    pub time_margin: usize,
     /// Resampling rounds.
     pub resample: usize,
     /// Provenance for the outputs' meta.
@@ -304,6 +317,8 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
             _ => None,
         },
         hold_body: !args.free_body,
+        hold_time: !args.free_time,
+        time_margin: args.time_margin,
         resample,
         meta,
     }))
@@ -388,9 +403,38 @@ fn plan_between(
         blend: args.blend,
         keep_path: Some(false),
         hold_body: false,
+        hold_time: false,
+        time_margin: 0,
         resample,
         meta,
     })
+}
+
+/// What `run --from` prints of the held time: the frames and seconds held exactly and the
+/// margin that eases into the edit.
+fn held_time_line(time: &[Range<usize>], frames: usize, margin: usize) -> String {
+    if time.is_empty() {
+        return "editing the take: every frame free (the program reads them all, or --free-time)"
+            .into();
+    }
+    let fps = mprog::skeleton::FPS;
+    let spans: Vec<String> = time
+        .iter()
+        .map(|r| {
+            format!(
+                "frames {}..{} ({:.2}–{:.2} s)",
+                r.start,
+                r.end,
+                r.start as f32 / fps,
+                r.end as f32 / fps
+            )
+        })
+        .collect();
+    format!(
+        "editing the take: untouched time held to the take: {} of {frames}; the {margin} frames ({:.2} s) next to what the program reads ease into the edit (--free-time, --time-margin change this)",
+        spans.join(", "),
+        margin as f32 / fps
+    )
 }
 
 fn ranges_json(r: &[Range<usize>]) -> serde_json::Value {
@@ -435,6 +479,13 @@ impl TakePlan {
         }
         let auto = auto_hold(&take, program, &Device::flex())
             .map_err(|e| miette!("cannot analyse the program on the take: {e}"))?;
+        // Untouched time: held exactly `time_margin` frames short of what the program reads.
+        let margin = self.time_margin;
+        let (time, time_weights) = if self.hold_time {
+            (auto.kept_time(margin), auto.time_weights(margin))
+        } else {
+            (Vec::new(), Vec::new())
+        };
         let hold_path = self.keep_path.unwrap_or(auto.path);
         let parts = if self.hold_body {
             auto.parts
@@ -450,6 +501,11 @@ impl TakePlan {
                 format!("held to the take: {}", parts.join(", "))
             }
         );
+        eprintln!("{}", held_time_line(&time, self.frames, margin));
+        self.meta.insert("held_time".into(), ranges_json(&time));
+        if self.hold_time {
+            self.meta.insert("time_margin".into(), margin.into());
+        }
         // The cleanup skips edits that hold both legs (see `Edit::clean_feet`).
         let legs_held = ["left leg", "right leg"].iter().all(|l| parts.contains(l));
         self.meta.insert("foot_cleanup".into(), (!legs_held).into());
@@ -457,12 +513,15 @@ impl TakePlan {
         self.meta
             .insert("held_parts".into(), serde_json::json!(parts));
         Ok(Edit {
-            hold: if self.keep.is_empty() {
-                Vec::new()
-            } else {
-                // An in-between's kept ranges already stop `blend` short of the gap.
-                hold_weights(self.frames, &self.keep, self.blend)
-            },
+            hold: merge_holds(
+                &if self.keep.is_empty() {
+                    Vec::new()
+                } else {
+                    // An in-between's kept ranges already stop `blend` short of the gap.
+                    hold_weights(self.frames, &self.keep, self.blend)
+                },
+                &time_weights,
+            ),
             take,
             strength: self.strength,
             hold_path,

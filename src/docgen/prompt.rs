@@ -263,7 +263,9 @@ with one complete program in a ```mprog code block, and nothing the language lac
 ## Conventions
 
 - Skeleton: HumanML3D, 22 joints (table below). Positions are in metres, **Y is up**, the
-  ground is y = 0. 20 frames per second; a motion is at most 196 frames (9.8 s).
+  ground is y = 0. 20 frames per second. A `length` may be up to 200 s: a motion longer
+  than 9.8 s is made in windows of at most 9.8 s, each continuing the last second of the
+  one before, and a constraint anywhere is steered by the window that makes its frames.
 - At frame 0 the person stands with the pelvis **at x = z = 0, facing +Z; their left is
   +X**, their right is −X. "Forward" is +Z, "backward" −Z, "to the left" +X. The solvers
   keep that start (only `latent` with `relax` may shift the whole motion), so a
@@ -366,6 +368,19 @@ minimize norm(acc(r_hand))             # any scalar
 - Several people: `people a "prompt of a", b "prompt of b"` replaces `prompt`; joints are
   then qualified (`a.r_hand`, `b.head`) and functions taking a person get `a`/`b`. With
   one person the person is called `me`.
+- Several actions in a row: a timeline of prompts. Give each prompt a time span (the
+  times of `during`), in time order, each at least 1 s long, together covering 0 s to
+  `end` without gaps; consecutive spans may overlap by at most half a span (the model
+  blends them). With several people, `prompt a 0s..3s "…"` is a span of `a`'s own
+  timeline (then give `a` no prompt on the `people` line).
+
+  ```mprog
+  length 20s
+  prompt 0s..8s "a person walks forward"
+  prompt 8s..14s "a person jogs in a circle"
+  prompt 13s..end "a person sits down"
+  during end - 0.5s..end + 1 { pelvis.y < 0.6 m }   # ends seated
+  ```
 "#;
 
 const SEMANTICS: &str = r#"
@@ -418,11 +433,11 @@ const RULES: &str = r#"
    and `during 0s..…` include, a joint 4 m up, 20 m travelled in a second).
 5. Keyframes must lie inside the length: with `length 4s`, `at 5s` is an error; prefer
    `start`, `mid`, `end` and percentages.
-6. Give a `length` (at most 9.8 s) and a `prompt` that describes the whole motion; the
-   constraints only steer it. An end state ("ends lying down", "ends crouched") is held
-   over the last half second, `during end - 0.5s..end + 1 { … }`: an `at end` block that
-   fixes the posture on the last frame alone makes the body snap into it
-   (`mprog::keyframe_pose`).
+6. Give a `length` (up to 200 s) and a `prompt` that describes the whole motion (a
+   timeline for several actions in a row); the constraints only steer it. An end state
+   ("ends lying down", "ends crouched") is held over the last half second,
+   `during end - 0.5s..end + 1 { … }`: an `at end` block that fixes the posture on the
+   last frame alone makes the body snap into it (`mprog::keyframe_pose`).
 7. Prefer tolerances to exact equalities for positions (`dist(p, q) < 5 cm`), and keep
    targets reachable: arms are about 0.6 m long, a step is about 0.7 m, walking speed is
    about 1.3 m/s. A hand target farther than that from where the person stands needs a
@@ -487,6 +502,9 @@ mod tests {
             "length 4s\nalways { dot(normalize(l_hand - l_shoulder), bodyLeft()) > 0.9\n dot(normalize(r_hand - r_shoulder), bodyLeft()) < -0.9 }\n",
             "length 4s\nat end { dot(gaze(), [1, 0, 0]) > 0.7 }\nat 1s { head.y < 1.2 m + 0.1 m/s * time@2s }\n",
             "length 4s\nduring end - 0.5s..end + 1 { pelvis.y < 0.5 m }\nalways { speed(pelvis) < 1.5 m/s }\n",
+            // The timeline bullet: a person's own timeline (its example is a block of the
+            // card, which tests/book.rs checks).
+            "length 6s\npeople a, b \"a person waves\"\nprompt a 0s..3s \"a person walks forward\"\nprompt a 3s..end \"a person sits down\"\nalways { separation(a, b, 0.5 m) }\n",
             // Rule 12's forms: ground speed, turn direction, torsos apart.
             "length 4s\nalways { speed(projToGround(pelvis)) > 1.7 }\nduring 0s..end - 1 { cross(facing(), vel(facing())).y > 0.5 }\n",
             "length 6s\npeople a \"x\", b \"y\"\nspacing 1 m\nduring 3s..end + 1 { contact(a.l_hand, b.spine3, 15 cm) }\nalways { noTorsoCollision(a, b, 12 cm) }\n",
@@ -515,6 +533,24 @@ mod tests {
             (a.x, a.z, a.yaw, b.x, b.z, b.yaw),
             (-0.5, 0.0, 0.0, 0.5, 0.0, 0.0)
         );
+    }
+
+    #[test]
+    fn card_gives_long_motions_and_a_twenty_second_timeline() {
+        let card = system_prompt();
+        assert!(!card.contains("at most 196 frames") && !card.contains("at most 9.8 s)"));
+        assert!(card.contains("up to 200 s"));
+        let blocks = super::super::markdown::code_blocks(&card);
+        let timeline = blocks
+            .iter()
+            .find(|b| b.lang == "mprog" && b.text.contains("prompt 0s.."))
+            .expect("the timeline example");
+        let p = crate::lang::compile(&timeline.text, "t.mprog", &[]).unwrap();
+        assert_eq!(p.length(), 400);
+        assert_eq!(p.timelines()[0].len(), 3);
+        assert_eq!(p.statements().len(), 1);
+        let d = crate::lang::check_source(&timeline.text, "t.mprog", &[]);
+        assert!(d.items.is_empty(), "{}", d.render_plain());
     }
 
     #[test]

@@ -368,3 +368,38 @@ fn bvh_through_read_motion_reports_the_import() {
     assert_eq!(meta["unit_scale"], 0.01f32);
     assert_eq!(people[0].motion.fps, 20.0);
 }
+
+#[test]
+fn pictures_draw_the_meta_timeline_and_refuse_a_broken_one() {
+    use super::outputs::OutputJob;
+    let people = [sample_motion(60, 0.0)];
+    let bvh = super::bvh_export::BvhExportOptions::default();
+    let picture = |meta: serde_json::Value| {
+        let meta = meta.as_object().unwrap().clone();
+        let job = OutputJob {
+            people: &people,
+            meta: &meta,
+            title: "t",
+            bvh: &bvh,
+        };
+        (
+            super::writers::png("t.png", &job),
+            super::writers::gif("t.gif", &job),
+        )
+    };
+    let (plain, plain_gif) = picture(serde_json::json!({}));
+    let timeline = serde_json::json!({"timeline": [[
+        {"from": 0, "to": 30, "prompt": "a person walks forward"},
+        {"from": 30, "to": 60, "prompt": "a person sits down"}
+    ]]});
+    let (with, with_gif) = picture(timeline);
+    assert_ne!(plain.unwrap(), with.unwrap());
+    assert_ne!(plain_gif.unwrap(), with_gif.unwrap());
+    let (bad, _) =
+        picture(serde_json::json!({"timeline": [[{"from": 70, "to": 80, "prompt": "x"}]]}));
+    let e = bad.unwrap_err();
+    assert!(
+        e.contains("t.png: meta.timeline[0]: span 70..80 starts past"),
+        "{e}"
+    );
+}

@@ -31,13 +31,13 @@ pub fn json(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
     super::json::json_bytes(origin, &people, job.meta).map_err(|e| e.to_string())
 }
 
-/// `.gif`: the animation, with the overlays in the meta.
+/// `.gif`: the animation, with the overlays and the prompt timeline in the meta.
 pub fn gif(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
     crate::render::gif_bytes(job.people, &picture_options(origin, job)?)
         .map_err(|e| format!("cannot render {origin}: {e}"))
 }
 
-/// `.png`: a strip of frames, with the overlays in the meta.
+/// `.png`: a strip of frames, with the overlays and the prompt timeline in the meta.
 pub fn png(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
     crate::render::strip_bytes(job.people, &picture_options(origin, job)?)
         .map_err(|e| format!("cannot render {origin}: {e}"))
@@ -54,6 +54,9 @@ fn picture_options(origin: &str, job: &OutputJob) -> Result<crate::render::Rende
     let mut opts = crate::render::RenderOptions::titled(job.title);
     opts.overlays =
         crate::view::overlays_from_meta(job.meta).map_err(|e| format!("{origin}: {e}"))?;
+    let frames = job.people.iter().map(|m| m.len()).max().unwrap_or(0);
+    opts.timeline = crate::view::timeline_from_meta(job.meta, job.people.len(), frames)
+        .map_err(|e| format!("{origin}: {e}"))?;
     Ok(opts)
 }
 

@@ -17,6 +17,10 @@ pub const BAD_SPACING: &str = "mprog::bad_spacing";
 /// A start placement (`at [x, 0, z]`, `facing [dx, 0, dz]`) that is not a constant point on
 /// the floor or horizontal direction, or that puts two people inside each other.
 pub const BAD_START: &str = "mprog::bad_start";
+/// A timeline of prompts (`prompt 0s..8s "…"`) with a span that is empty, shorter than
+/// 1 s or past the length, spans out of time order, a gap, an overlap that is no blend, an
+/// empty text, or a person given both a whole-motion prompt and a timeline.
+pub const BAD_TIMELINE: &str = "mprog::bad_timeline";
 /// A negative or non-constant `weight`.
 pub const BAD_WEIGHT: &str = "mprog::bad_weight";
 /// `a < b < c`: write two constraints.
@@ -40,8 +44,6 @@ pub const FRAME_JUMP: &str = "mprog::frame_jump";
 /// absolute height of the pelvis, spine, neck, head or centre of mass, or of two or more
 /// joints other than the feet (warning; hold the end state over a `during` window).
 pub const KEYFRAME_POSE: &str = "mprog::keyframe_pose";
-/// A `length` longer than the model's 9.8 s.
-pub const LONG_MOTION: &str = "mprog::long_motion";
 /// `%` outside a time position.
 pub const MISPLACED_PERCENT: &str = "mprog::misplaced_percent";
 /// A time position (`start`, `end`, `2s`) used as a value.
@@ -122,6 +124,10 @@ pub const ALL: &[(&str, &str)] = &[
         BAD_START,
         "a start placement (`at [x, 0, z]`, `facing [dx, 0, dz]`) that is not a constant point on the floor or horizontal direction, or that puts two people inside each other",
     ),
+    (
+        BAD_TIMELINE,
+        "a timeline of prompts (`prompt 0s..8s \"…\"`) with a span that is empty, shorter than 1 s or past the length, spans out of time order, a gap, an overlap that is no blend, an empty text, or a person given both a whole-motion prompt and a timeline",
+    ),
     (BAD_WEIGHT, "a negative or non-constant `weight`"),
     (CHAINED_COMPARISON, "`a < b < c`: write two constraints"),
     (DIVISION_BY_ZERO, "division by a constant zero"),
@@ -147,7 +153,6 @@ pub const ALL: &[(&str, &str)] = &[
         KEYFRAME_POSE,
         "a single-frame `at` on the last 0.25 s (`at end`) that fixes the body's posture: the absolute height of the pelvis, spine, neck, head or centre of mass, or of two or more joints other than the feet, which the motion would snap into on its last frame (warning; hold the end state over a `during` window)",
     ),
-    (LONG_MOTION, "a `length` longer than the model's 9.8 s"),
     (MISPLACED_PERCENT, "`%` outside a time position"),
     (
         MISPLACED_TIME,

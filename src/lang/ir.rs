@@ -332,6 +332,37 @@ impl Ir {
         }
     }
 
+    /// Per frame of a motion of `f` frames, whether some statement's error reads it: the
+    /// frames of every joint read (`Gather`, `MassCenter`) its error or its `if` mask
+    /// depends on, so a velocity's or an acceleration's neighbours count and a read at a
+    /// keyframe (`hand@2s`) counts only there. A statement of weight 0 reads nothing.
+    /// Whether the statement is met does not matter: a met frame is still constrained.
+    pub fn active_frames(&self, f: usize) -> Vec<bool> {
+        let mut live = vec![false; self.nodes.len()];
+        for s in self.statements.iter().filter(|s| s.weight != 0.0) {
+            live[s.error] = true;
+            if let Some(m) = s.mask {
+                live[m] = true;
+            }
+        }
+        let mut active = vec![false; f];
+        for i in (0..self.nodes.len()).rev() {
+            if !live[i] {
+                continue;
+            }
+            let op = &self.nodes[i].op;
+            op.args().into_iter().for_each(|a| live[a] = true);
+            if let Op::Gather { domain, .. } | Op::MassCenter { domain, .. } = op {
+                for t in self.resolve_domain(*domain, f) {
+                    if let Some(a) = active.get_mut(t) {
+                        *a = true;
+                    }
+                }
+            }
+        }
+        active
+    }
+
     /// Number of frames a node spans for a motion of `f` frames.
     pub fn frames_of(&self, n: NodeId, f: usize) -> usize {
         match self.nodes[n].frames {
@@ -379,5 +410,43 @@ impl Ir {
             ops: ops + 2,
             elements_per_sample: elements,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The frames of a 60-frame motion that `body` (a program of 60 frames) reads.
+    fn active(body: &str) -> Vec<usize> {
+        let source = format!("prompt \"a person walks\"\nlength 60 frames\n{body}\n");
+        let p = crate::lang::compile(&source, "t.mprog", &[]).unwrap_or_else(|d| panic!("{d:?}"));
+        let a = p.ir().active_frames(60);
+        (0..60).filter(|&t| a[t]).collect()
+    }
+
+    #[test]
+    fn active_frames_are_the_frames_statements_read() {
+        // A window: its frames, met or not.
+        let second_half = active("during 50%..end + 1 { dist(l_hand, head) < 15 cm }");
+        assert_eq!(second_half, (30..60).collect::<Vec<_>>());
+        assert_eq!(
+            active("during 50%..100% { dist(l_hand, head) < 15 cm }"),
+            (30..59).collect::<Vec<_>>()
+        );
+        // Every frame, at top level or in `always`.
+        assert_eq!(active("head.y > 0 m").len(), 60);
+        assert_eq!(active("always { head.y > 0 m }").len(), 60);
+        // A velocity reads the next frame too; an acceleration the next two.
+        assert_eq!(
+            active("during 1s..2s { vel(pelvis).y < 1 m/s }"),
+            (20..41).collect::<Vec<_>>()
+        );
+        assert_eq!(active("at 1s { norm(acc(pelvis)) < 1 }"), [20, 21, 22]);
+        // A keyframe read inside another keyframe: both frames, nothing between.
+        assert_eq!(active("at 2s { dist(l_hand, head@1s) < 10 cm }"), [20, 40]);
+        // A statement of weight 0 counts for nothing.
+        assert_eq!(
+            active("weight 0 { head.y > 0 m }\nat end { head.y > 0 m }"),
+            [59]
+        );
     }
 }

@@ -18,7 +18,7 @@ pub mod ir;
 pub mod stdlib;
 pub mod syntax;
 
-pub use check::{Header, ParamInfo, PersonInfo};
+pub use check::{Header, ParamInfo, PersonInfo, TimedPrompt};
 pub use diag::{Diagnostic, Diagnostics, Severity};
 pub use eval::{EvalError, Evaluation, FrameErrors, MAX_EVAL_ELEMENTS};
 pub use ir::CostEstimate;
@@ -61,14 +61,15 @@ pub fn check_source(source: &str, name: &str, overrides: &[(String, f64)]) -> Di
     }
 }
 
-/// The prompts a program gives (its `prompt` line, and each person's on a `people`
-/// line) with where they are written; empty when the program does not parse.
+/// The prompts a program gives (its `prompt` lines, timeline spans included, and each
+/// person's on a `people` line) with where they are written; empty when the program does
+/// not parse.
 pub fn prompts_of(source: &str) -> Vec<(String, syntax::ast::Span)> {
     let (module, _) = syntax::source_to_ast(source);
     let mut out = Vec::new();
     for item in &module.items {
         match item {
-            syntax::ast::Item::Prompt { text, span } => out.push((text.clone(), *span)),
+            syntax::ast::Item::Prompt { text, span, .. } => out.push((text.clone(), *span)),
             syntax::ast::Item::People { people, span } => out.extend(
                 people
                     .iter()
@@ -154,6 +155,18 @@ impl crate::objective::MotionError for Program {
     fn terms(&self, joints: Tensor<5>) -> Tensor<2> {
         self.evaluate(joints).per_statement
     }
+
+    fn error_until(&self, joints: Tensor<5>, until: usize) -> Tensor<1> {
+        self.evaluate_until(joints, until).total
+    }
+
+    fn terms_until(&self, joints: Tensor<5>, until: usize) -> Tensor<2> {
+        self.evaluate_until(joints, until).per_statement
+    }
+
+    fn active_frames(&self, frames: usize) -> Option<Vec<bool>> {
+        Some(self.checked.ir.active_frames(frames))
+    }
 }
 
 impl Program {
@@ -209,6 +222,27 @@ impl Program {
         eval::evaluate(&self.checked.ir, joints, &self.cache)
     }
 
+    /// [`Program::evaluate`] counting only the frames before `until` (each statement's
+    /// mean over its frames before it; 0 for a statement with none): a window of a long
+    /// motion.
+    ///
+    /// # Panics
+    /// As [`Program::evaluate`].
+    pub fn evaluate_until(&self, joints: Tensor<5>, until: usize) -> Evaluation {
+        let [batch, _, frames, _, _] = joints.dims();
+        let cost = self.checked.ir.cost_estimate_at(frames);
+        if cost.elements(batch) > MAX_EVAL_ELEMENTS {
+            panic!(
+                "{}: evaluating {batch} motion(s) of {frames} frames exceeds the element limit",
+                self.name
+            );
+        }
+        match eval::evaluate_until(&self.checked.ir, joints, &self.cache, until) {
+            Ok(e) => e,
+            Err(e) => panic!("{}: {e}", self.name),
+        }
+    }
+
     /// Each statement's error per frame (host values, no gradient), in statement order:
     /// what [`Program::evaluate`] averages.
     pub fn evaluate_frames(&self, joints: Tensor<5>) -> Result<Vec<FrameErrors>, EvalError> {
@@ -242,12 +276,26 @@ impl Program {
         self.checked.header.prompt.as_deref()
     }
 
-    /// One prompt per person (the person's own, else the program's).
+    /// One prompt per person (the person's own, else the program's); for a timeline, the
+    /// prompt of its first span ([`Program::timelines`] has them all).
     pub fn prompts(&self) -> Vec<Option<String>> {
         let h = &self.checked.header;
         h.people
             .iter()
             .map(|p| p.prompt.clone().or_else(|| h.prompt.clone()))
+            .collect()
+    }
+
+    /// Each person's timeline (tensor order): their prompts in time order with the frames
+    /// each covers at [`Program::length`], together covering `0..length` (consecutive ones
+    /// may overlap, a blend). A prompt without a span is one entry `0..length`; a person
+    /// without any prompt (their own or the program's) has none.
+    pub fn timelines(&self) -> Vec<Vec<TimedPrompt>> {
+        self.checked
+            .header
+            .people
+            .iter()
+            .map(|p| p.timeline.clone())
             .collect()
     }
 

@@ -8,6 +8,7 @@
 //! | linear algebra | [`linalg`] | Jacobi eigen-decomposition, PSD square root (f64) |
 //! | set scores | [`scores`] | FID, diversity, R-precision on embeddings |
 //! | evaluator | [`encoder`], [`evaluator`], [`train_encoder`], [`card`] | contrastive motion/caption encoders, their files, their training |
+//! | text match | [`text_match`] | a motion's similarity to its prompts by the evaluator, per prompt span, long spans in windows |
 //! | report | [`report`], [`table`] | generate for test captions, score every set, markdown tables |
 
 pub mod actions;
@@ -21,6 +22,7 @@ pub mod plausibility;
 pub mod report;
 pub mod scores;
 pub mod table;
+pub mod text_match;
 pub mod train_encoder;
 
 pub use error::MetricsError;

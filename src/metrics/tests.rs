@@ -379,3 +379,71 @@ fn foot_cleanup_lowers_the_skating_ratio() {
     let after = super::per_motion::foot_skating_ratio(&recover_from_ric(&rows).unwrap());
     assert!(after < before, "skating {before} -> {after}");
 }
+
+#[test]
+fn text_match_scores_each_span_of_a_long_motion_against_its_prompt() {
+    use super::text_match::{PromptSpan, text_match};
+    let data = synthetic_dataset([4, 1, 0]);
+    let (evaluator, _) = train_evaluator(&data, &tiny_training(60), &mut |_, _| {}).unwrap();
+    let window = evaluator.manifest.config.max_frames;
+    // A walk of 150 frames, then a squat of 100 where the walk ended: longer than the
+    // evaluator's 60 frames, so both spans are scored in windows.
+    let walk = synthetic_motion(0, 150, 0.3);
+    let end = walk.frames[149][0] - rest_pose()[0];
+    let squat = synthetic_motion(3, 100, 0.3);
+    let mut frames = walk.frames[..150].to_vec();
+    frames.extend(
+        squat
+            .frames
+            .iter()
+            .map(|p| p.map(|q| q + Vec3::new(end.x, 0.0, end.z))),
+    );
+    let motion = Motion::new(frames);
+    assert!(motion.len() > 3 * window);
+    let span = |from, to, prompt: &str| PromptSpan {
+        person: 0,
+        from,
+        to,
+        prompt: prompt.into(),
+    };
+    let spans = [span(0, 150, LABELS[0].1), span(150, 300, LABELS[3].1)];
+    let dev = Device::flex();
+    let got = text_match(&evaluator, std::slice::from_ref(&motion), &spans, &dev).unwrap();
+    assert_eq!(got.len(), 2);
+    assert_eq!(
+        got[0].windows,
+        super::text_match::windows(149, window).len()
+    );
+    assert!(got[0].windows >= 3 && got[1].windows >= 2);
+    assert_eq!(got[1].span.to, motion.len(), "cut to the motion");
+    for (m, s) in got.iter().zip(&spans) {
+        let sim = m.similarity.unwrap();
+        assert!((-1.0..=1.0).contains(&sim));
+        // Each span looks most like its own prompt.
+        assert_eq!(m.closest.as_ref().unwrap().0, s.prompt, "{m:?}");
+    }
+    // One span over the whole motion: its own prompt only, no "closest".
+    let whole = text_match(
+        &evaluator,
+        std::slice::from_ref(&motion),
+        &[span(0, 300, "a person walks forward")],
+        &dev,
+    )
+    .unwrap();
+    assert!(whole[0].closest.is_none() && whole[0].windows > 1);
+    // A prompt without a known word has no similarity; a missing person is an error.
+    let odd = text_match(
+        &evaluator,
+        std::slice::from_ref(&motion),
+        &[span(0, 100, "zyx qwv")],
+        &dev,
+    )
+    .unwrap();
+    assert_eq!(odd[0].similarity, None);
+    assert_eq!(odd[0].unknown_words, ["zyx", "qwv"]);
+    let bad = PromptSpan {
+        person: 1,
+        ..span(0, 100, "a person walks forward")
+    };
+    assert!(text_match(&evaluator, &[motion], &[bad], &dev).is_err());
+}

@@ -1,6 +1,8 @@
 //! The animated GIF: every (subsampled) frame drawn as a caption line with the time and
 //! frame counter over two panels — the side view on the left, the top view on the right —
-//! with both cameras fixed over the whole clip, then encoded and written atomically.
+//! with both cameras fixed over the whole clip, then encoded and written atomically. With
+//! a prompt timeline the side view's caption names the prompt active at the frame and a
+//! bar of the spans with a cursor at the frame runs along the bottom.
 
 use super::camera::{Rect, View};
 use super::draw::{Area, TOP_LEFT, TOP_RIGHT, line, render_rgb, text};
@@ -11,6 +13,7 @@ use super::frames::{gif_delays, gif_frames};
 use super::options::RenderOptions;
 use super::scene::Scene;
 use super::style::{GRID, TEXT};
+use super::timeline::{BarMarks, Timeline};
 use super::views::{
     TopMarks, draw_caption, draw_side, draw_top, label_height, side_view, top_caption, top_view,
 };
@@ -38,6 +41,8 @@ struct Layout {
     font: f64,
     side: Rect,
     top: Rect,
+    /// The timeline bar along the bottom, when there is one.
+    bar: Option<Rect>,
     side_view: View,
     top_view: View,
 }
@@ -45,7 +50,12 @@ struct Layout {
 impl Layout {
     /// Side by side (side view on the left), unless the clip travels so far that stacking
     /// the views (side view on top, full width) draws the figures much larger.
-    fn new(scene: &Scene, w: u32, h: u32) -> Result<Layout, RenderError> {
+    fn new(
+        scene: &Scene,
+        w: u32,
+        h: u32,
+        timeline: Option<&Timeline>,
+    ) -> Result<Layout, RenderError> {
         if w < 160 || h < 100 {
             return Err(RenderError::BadOption(format!(
                 "GIF size {w}x{h} is too small (min 160x100)"
@@ -54,7 +64,19 @@ impl Layout {
         let (wf, hf) = (w as f32, h as f32);
         let title_h = (hf * 0.075).clamp(16.0, 32.0).round();
         let font = f64::from(title_h) * 0.62;
-        let body = hf - title_h;
+        let bar_h = timeline.map_or(0.0, |t| t.bar_height(font * 0.8, false).ceil());
+        let body = hf - title_h - bar_h;
+        if body < 60.0 {
+            return Err(RenderError::BadOption(format!(
+                "GIF size {w}x{h} leaves no room for the views under the timeline"
+            )));
+        }
+        let bar = timeline.map(|_| Rect {
+            x: 0.0,
+            y: hf - bar_h,
+            w: wf,
+            h: bar_h,
+        });
         let side_w = (wf * SIDE_SHARE).round();
         let beside = (
             Rect {
@@ -106,6 +128,7 @@ impl Layout {
             font,
             side,
             top,
+            bar,
             side_view: side_view(scene, inner(side)),
             top_view: top_view(scene, inner(top)),
         })
@@ -130,11 +153,12 @@ pub fn gif_bytes(people: &[Motion], opts: &RenderOptions) -> Result<Vec<u8>, Ren
     let scene = Scene::new(people, opts)?;
     let frames = gif_frames(scene.len, opts)?;
     let delays = gif_delays(&frames, scene.fps, opts.frame_step)?;
-    let layout = Layout::new(&scene, opts.size.0, opts.size.1)?;
+    let timeline = Timeline::new(opts, scene.len)?;
+    let layout = Layout::new(&scene, opts.size.0, opts.size.1, timeline.as_ref())?;
     ensure_fonts()?;
     let paint = |frame: usize| {
         render_rgb(layout.w, layout.h, |area| {
-            paint_frame(area, &scene, &layout, frame, &opts.title)
+            paint_frame(area, &scene, &layout, frame, &opts.title, timeline.as_ref())
         })
     };
     let n = PALETTE_SAMPLES.min(frames.len());
@@ -167,6 +191,7 @@ fn paint_frame(
     layout: &Layout,
     frame: usize,
     title: &str,
+    timeline: Option<&Timeline>,
 ) -> Result<(), RenderError> {
     let font = layout.font;
     let last = scene.len - 1;
@@ -193,7 +218,15 @@ fn paint_frame(
 
     let small = font * 0.8;
     draw_side(area, scene, &layout.side_view, frame, small)?;
-    draw_caption(area, layout.side, "side view", small)?;
+    let side_caption = match timeline {
+        Some(t) => fit_text(
+            &format!("side view — {}", t.caption(frame)),
+            small,
+            f64::from(layout.side.w) - 10.0,
+        ),
+        None => "side view".to_string(),
+    };
+    draw_caption(area, layout.side, &side_caption, small)?;
     draw_top(
         area,
         scene,
@@ -209,8 +242,19 @@ fn paint_frame(
     )?;
 
     let (tx, ty) = (layout.top.x as i32, layout.top.y as i32);
+    if let (Some(t), Some(bar)) = (timeline, layout.bar) {
+        t.draw_bar(area, bar, &BarMarks::Cursor(frame), small)?;
+        line(
+            area,
+            (0, bar.y as i32),
+            (layout.w as i32, bar.y as i32),
+            GRID,
+            1,
+        )?;
+    }
+    let bottom = layout.bar.map_or(layout.h as i32, |b| b.y as i32);
     if tx > 0 {
-        line(area, (tx, ty), (tx, layout.h as i32), GRID, 1)?;
+        line(area, (tx, ty), (tx, bottom), GRID, 1)?;
     } else {
         line(area, (0, ty), (layout.w as i32, ty), GRID, 1)?;
     }
@@ -234,16 +278,16 @@ mod tests {
     fn long_walks_stack_the_views_short_clips_keep_them_side_by_side() {
         let opts = RenderOptions::default();
         let still = [Motion::new(vec![rest_pose(); 5])];
-        let beside = Layout::new(&Scene::new(&still, &opts).unwrap(), 640, 320).unwrap();
+        let beside = Layout::new(&Scene::new(&still, &opts).unwrap(), 640, 320, None).unwrap();
         assert!(beside.top.x > 0.0 && beside.top.y == beside.side.y);
         let long = [walk(200, 1.2, Vec3::ZERO, Vec3::Z)];
-        let stacked = Layout::new(&Scene::new(&long, &opts).unwrap(), 640, 320).unwrap();
+        let stacked = Layout::new(&Scene::new(&long, &opts).unwrap(), 640, 320, None).unwrap();
         assert!(stacked.top.x == 0.0 && stacked.top.y > stacked.side.y);
         // Stacking must actually draw the walker larger than side by side would.
         assert!(
             stacked.side_view.scale
                 > STACK_GAIN * side_view(&Scene::new(&long, &opts).unwrap(), beside.side).scale
         );
-        assert!(Layout::new(&Scene::new(&still, &opts).unwrap(), 100, 50).is_err());
+        assert!(Layout::new(&Scene::new(&still, &opts).unwrap(), 100, 50, None).is_err());
     }
 }

@@ -13,7 +13,8 @@
 //!   the current pose, root and facing arrow (GIF) or numbered markers (strip).
 //!
 //! Overlays ([`Overlay`]: points, segments, walls, horizontal planes, boxes) are drawn in
-//! both views in magenta.
+//! both views in magenta. A prompt timeline ([`RenderOptions::timeline`]) with more than
+//! one prompt adds the active prompt to each frame's caption and a bar of the spans.
 //!
 //! ```no_run
 //! use mprog::render::{Overlay, RenderOptions, render_to_path};
@@ -30,7 +31,8 @@
 //! output file is written then: every file goes through
 //! [`fsutil::write_bytes_atomic`](crate::fsutil::write_bytes_atomic).
 //!
-//! Line plots ([`plot_lines`]) draw named [`Series`] with axes, legend and optional log-y.
+//! Line plots ([`plot_lines`]) draw named [`Series`] with axes, legend, optional log-y and
+//! labelled bands ([`Band`]: a prompt timeline's spans).
 
 mod animate;
 mod camera;
@@ -47,6 +49,7 @@ mod plot;
 mod scene;
 mod strip;
 mod style;
+mod timeline;
 mod views;
 
 #[cfg(test)]
@@ -58,8 +61,8 @@ mod tests;
 
 pub use animate::{gif_bytes, render_gif};
 pub use error::RenderError;
-pub use options::{Overlay, RenderOptions, StripFrames};
-pub use plot::{PlotOptions, Series, plot_lines};
+pub use options::{Overlay, RenderOptions, StripFrames, TimelineSpan};
+pub use plot::{Band, PlotOptions, Series, plot_lines};
 pub use strip::{render_strip_png, strip_bytes};
 
 use crate::motion::Motion;

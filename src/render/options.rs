@@ -1,6 +1,6 @@
 //! What a caller can ask of a motion render: caption, picture sizes, which frames, the
-//! camera, and overlay geometry (points, segments, planes, boxes in world coordinates)
-//! drawn into both views. Plain data in, validated by the renderers.
+//! camera, overlay geometry (points, segments, planes, boxes in world coordinates) drawn
+//! into both views, and the prompt timeline. Plain data in, validated by the renderers.
 
 pub use crate::scene::Overlay;
 use std::ops::Range;
@@ -30,6 +30,22 @@ pub struct RenderOptions {
     pub camera_yaw_deg: Option<f32>,
     /// Extra geometry drawn into both views.
     pub overlays: Vec<Overlay>,
+    /// Each person's prompt timeline (person order; an empty list for a person without
+    /// one). Drawn when some person has more than one prompt: each frame's caption names
+    /// the prompt active then, a bar under the views shows the spans, and the strip picks
+    /// its frames so that every span gets one when it can.
+    pub timeline: Vec<Vec<TimelineSpan>>,
+}
+
+/// One prompt of a timeline: the frames `from..to` (half-open) it covers.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TimelineSpan {
+    /// First frame.
+    pub from: usize,
+    /// One past the last frame.
+    pub to: usize,
+    /// The prompt.
+    pub prompt: String,
 }
 
 impl Default for RenderOptions {
@@ -44,6 +60,7 @@ impl Default for RenderOptions {
             strip_frames: StripFrames::Count(8),
             camera_yaw_deg: None,
             overlays: Vec::new(),
+            timeline: Vec::new(),
         }
     }
 }

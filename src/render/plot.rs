@@ -1,11 +1,13 @@
 //! Line plots to PNG: named series of (x, y) points drawn with axes, ticks, axis labels, a
 //! title and a legend, on a linear or logarithmic y axis — training loss curves and a
-//! program's per-statement error over time.
+//! program's per-statement error over time, the latter with the prompt timeline's spans
+//! as labelled bands ([`PlotOptions::bands`]).
 
-use super::draw::{disc, line, polyline, render_rgb, text};
+use super::draw::{disc, line, polyline, render_rgb, text, veil};
 use super::encode::encode_png;
 use super::error::{RenderError, draw_err};
-use super::font::{FAMILY, ensure_fonts};
+use super::font::{FAMILY, ensure_fonts, fit_text};
+use super::timeline::SPAN_COLORS;
 use crate::fsutil::write_bytes_atomic;
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
@@ -30,6 +32,21 @@ pub struct PlotOptions {
     pub size: (u32, u32),
     /// Logarithmic y axis (points with y ≤ 0 are left out).
     pub log_y: bool,
+    /// Shaded x ranges drawn behind the lines, each labelled at its top left (a prompt
+    /// timeline's spans on an error-over-time plot); a band outside the points' range is
+    /// cut to it.
+    pub bands: Vec<Band>,
+}
+
+/// A labelled x range of a plot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Band {
+    /// Where it starts (x units).
+    pub from: f32,
+    /// Where it ends.
+    pub to: f32,
+    /// Its label (a prompt).
+    pub label: String,
 }
 
 impl Default for PlotOptions {
@@ -37,6 +54,7 @@ impl Default for PlotOptions {
         PlotOptions {
             size: (800, 480),
             log_y: false,
+            bands: Vec::new(),
         }
     }
 }
@@ -115,6 +133,16 @@ pub(crate) fn plot_png(
         };
         return Err(RenderError::BadPlot(why.into()));
     }
+    if let Some(b) = opts
+        .bands
+        .iter()
+        .find(|b| !(b.from.is_finite() && b.to.is_finite() && b.from < b.to))
+    {
+        return Err(RenderError::BadPlot(format!(
+            "band {}..{} (\"{}\") is empty or not finite",
+            b.from, b.to, b.label
+        )));
+    }
     let xr = padded(all.iter().map(|p| p.0), false);
     let yr = padded(all.iter().map(|p| p.1), opts.log_y);
     ensure_fonts()?;
@@ -122,6 +150,8 @@ pub(crate) fn plot_png(
         title,
         x: x_label,
         y: y_label,
+        bands: &opts.bands,
+        y_any: yr.start,
     };
     let rgb = render_rgb(w, h, |area| {
         area.fill(&WHITE).map_err(draw_err)?;
@@ -146,6 +176,9 @@ struct Labels<'a> {
     title: &'a str,
     x: &'a str,
     y: &'a str,
+    bands: &'a [Band],
+    /// A y value on the axis, for mapping x values to pixels.
+    y_any: f32,
 }
 
 /// Data range with a 5 % margin (multiplicative on a log axis); a single value gets a
@@ -219,6 +252,7 @@ where
     Y::CoordDescType: ValueFormatter<f32>,
 {
     let x0 = xr.start;
+    let (x_lo, x_hi) = (xr.start, xr.end);
     let mut chart = ChartBuilder::on(area)
         .caption(labels.title, (FAMILY, 18))
         .margin(12)
@@ -257,6 +291,37 @@ where
                 12.0,
                 RGBColor(0, 0, 0),
                 (HPos::Right, VPos::Center),
+            )?;
+        }
+    }
+    let (_, rows) = chart.plotting_area().get_pixel_range();
+    for (i, band) in labels.bands.iter().enumerate() {
+        let (from, to) = (band.from.max(x_lo), band.to.min(x_hi));
+        if from >= to {
+            continue;
+        }
+        let color = SPAN_COLORS[i % SPAN_COLORS.len()];
+        let a = chart.backend_coord(&(from, labels.y_any)).0;
+        let b = chart.backend_coord(&(to, labels.y_any)).0;
+        let (top, bottom) = (rows.start, rows.end - 1);
+        veil(
+            area,
+            vec![(a, top), (b, top), (b, bottom), (a, bottom)],
+            color,
+            0.10,
+        )?;
+        if band.from >= x_lo {
+            line(area, (a, top), (a, bottom), color, 1)?;
+        }
+        let room = f64::from(b - a - 8);
+        if room > 16.0 {
+            text(
+                area,
+                &fit_text(&band.label, 12.0, room),
+                (a + 4, top + 4),
+                12.0,
+                color,
+                (HPos::Left, VPos::Top),
             )?;
         }
     }
@@ -362,5 +427,71 @@ mod tests {
         assert!(plot_lines(&dir.path().join("loss.gif"), "t", "x", "y", &[train], &opts).is_err());
         assert!(!bad.exists());
         assert_eq!(dir_entries(dir.path()), 1);
+    }
+
+    #[test]
+    fn bands_shade_and_label_the_prompt_spans() {
+        let errors = Series {
+            name: "line 3".into(),
+            points: (0..600)
+                .map(|f| (f as f32 / 20.0, (f as f32 / 50.0).sin()))
+                .collect(),
+        };
+        let band = |from: f32, to: f32, label: &str| Band {
+            from,
+            to,
+            label: label.into(),
+        };
+        let opts = PlotOptions {
+            bands: vec![
+                band(0.0, 12.0, "a person walks forward"),
+                band(12.0, 20.0, "a person jogs"),
+                band(20.0, 30.0, "a person sits down"),
+            ],
+            ..PlotOptions::default()
+        };
+        let plain = plot_png(
+            "t",
+            "time (s)",
+            "error",
+            std::slice::from_ref(&errors),
+            &PlotOptions::default(),
+        )
+        .unwrap();
+        let png = plot_png(
+            "t",
+            "time (s)",
+            "error",
+            std::slice::from_ref(&errors),
+            &opts,
+        )
+        .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+        std::fs::write(&a, plain).unwrap();
+        std::fs::write(&b, png).unwrap();
+        let (w, _, rgb) = decode_png(&b);
+        let (_, _, rgb0) = decode_png(&a);
+        // Each band's edge line and label are in its colour; none without bands.
+        for c in &SPAN_COLORS[1..3] {
+            assert!(pixels_of(&rgb, w, *c).len() > 100, "{c:?}");
+            assert!(pixels_of(&rgb0, w, *c).is_empty());
+        }
+        // The second band's edge is a vertical line at 12 s, left of the third's at 20 s.
+        let x_of = |c: RGBColor| {
+            let px = pixels_of(&rgb, w, c);
+            let mut xs: Vec<usize> = px.iter().map(|p| p.0).collect();
+            xs.sort_unstable();
+            xs[0]
+        };
+        assert!(x_of(SPAN_COLORS[1]) + 100 < x_of(SPAN_COLORS[2]));
+        let empty = PlotOptions {
+            bands: vec![band(3.0, 3.0, "x")],
+            ..PlotOptions::default()
+        };
+        assert!(matches!(
+            plot_png("t", "x", "y", &[errors], &empty),
+            Err(RenderError::BadPlot(_))
+        ));
     }
 }

@@ -352,3 +352,129 @@ fn demo_renders_for_inspection() {
     )
     .unwrap();
 }
+
+/// A 12 s walk with three prompts; the middle one (1 s) holds none of 4 evenly spaced
+/// frames.
+fn timeline_walk() -> (Motion, Vec<Vec<TimelineSpan>>) {
+    let span = |from, to, prompt: &str| TimelineSpan {
+        from,
+        to,
+        prompt: prompt.into(),
+    };
+    (
+        walk(240, 1.0, Vec3::ZERO, Vec3::Z),
+        vec![vec![
+            span(0, 100, "a person walks forward"),
+            span(100, 120, "a person waves"),
+            span(110, 240, "a person sits down"),
+        ]],
+    )
+}
+
+#[test]
+fn strip_with_a_timeline_names_each_cells_prompt_and_covers_every_span() {
+    use super::style::fade;
+    use super::timeline::SPAN_COLORS;
+    let dir = tempfile::tempdir().unwrap();
+    let (m, timeline) = timeline_walk();
+    let plain = RenderOptions {
+        strip_frames: StripFrames::Count(4),
+        ..RenderOptions::titled("three prompts")
+    };
+    let with = RenderOptions {
+        timeline: timeline.clone(),
+        ..plain.clone()
+    };
+    let (a, b) = (
+        dir.path().join("plain.png"),
+        dir.path().join("timeline.png"),
+    );
+    render_strip_png(std::slice::from_ref(&m), &plain, &a).unwrap();
+    render_strip_png(std::slice::from_ref(&m), &with, &b).unwrap();
+    let (_, h0, _) = decode_png(&a);
+    let (w, h1, rgb) = decode_png(&b);
+    // A second caption line per cell and the bar make the picture taller.
+    assert!(h1 > h0 + 20, "{h0} -> {h1}");
+    // Every span is in the bar, in its own colour, on one row of pixels' height.
+    for (k, c) in SPAN_COLORS.iter().take(3).enumerate() {
+        let px = pixels_of(&rgb, w, fade(*c, 0.72));
+        assert!(px.len() > 30, "span {k}: {} pixels", px.len());
+        let ys = px.iter().map(|p| p.1);
+        assert!(
+            ys.clone().max().unwrap() - ys.min().unwrap() < 30,
+            "span {k}"
+        );
+    }
+    assert!(pixels_of(&decode_png(&a).2, w, fade(SPAN_COLORS[0], 0.72)).is_empty());
+    // The strip's frames moved so that the 1 s wave has a cell; an explicit list stays.
+    let scene = Scene::new(std::slice::from_ref(&m), &with).unwrap();
+    let tl = super::timeline::Timeline::new(&with, scene.len)
+        .unwrap()
+        .unwrap();
+    let spans: Vec<_> = tl.spans().collect();
+    let even = super::frames::strip_frames(240, &with).unwrap();
+    assert!(!even.iter().any(|f| (100..120).contains(f)), "{even:?}");
+    let moved = super::timeline::cover_spans(even, &spans, &(0..240));
+    assert!(moved.iter().any(|f| (100..120).contains(f)), "{moved:?}");
+    assert_eq!(tl.caption(moved[1]), "\"a person waves\"");
+    // One prompt only: no bar, the same picture as without a timeline.
+    let one = RenderOptions {
+        timeline: vec![vec![TimelineSpan {
+            from: 0,
+            to: 240,
+            prompt: "a person walks forward".into(),
+        }]],
+        ..plain.clone()
+    };
+    assert_eq!(
+        strip_bytes(std::slice::from_ref(&m), &one).unwrap(),
+        std::fs::read(&a).unwrap()
+    );
+    // A span past the clip is refused.
+    let bad = RenderOptions {
+        timeline: vec![vec![
+            TimelineSpan {
+                from: 0,
+                to: 300,
+                prompt: "a".into(),
+            },
+            TimelineSpan {
+                from: 250,
+                to: 300,
+                prompt: "b".into(),
+            },
+        ]],
+        ..plain
+    };
+    assert!(matches!(
+        strip_bytes(&[m], &bad),
+        Err(RenderError::BadOption(_))
+    ));
+}
+
+#[test]
+fn gif_with_a_timeline_marks_the_active_prompt_on_its_bar() {
+    use super::style::fade;
+    use super::timeline::SPAN_COLORS;
+    let dir = tempfile::tempdir().unwrap();
+    let (m, timeline) = timeline_walk();
+    let path = dir.path().join("t.gif");
+    let opts = RenderOptions {
+        frame_step: 10,
+        timeline,
+        ..RenderOptions::titled("three prompts")
+    };
+    render_gif(&[m], &opts, &path).unwrap();
+    let g = decode_gif(&path);
+    assert_eq!((g.w, g.h, g.frames.len()), (640, 320, 24));
+    // Frame 50 (GIF frame 5): the walk's span is drawn active, the sit's not; at frame
+    // 200 (GIF frame 20) the other way round. The bar is the bottom of the picture.
+    let active = |rgb: &[u8], k: usize| {
+        pixels_of(rgb, g.w, fade(SPAN_COLORS[k], 0.35))
+            .iter()
+            .filter(|p| p.1 > 280)
+            .count()
+    };
+    assert!(active(&g.frames[5], 0) > 100 && active(&g.frames[5], 2) == 0);
+    assert!(active(&g.frames[20], 2) > 100 && active(&g.frames[20], 0) == 0);
+}

@@ -373,9 +373,54 @@ impl Session {
         };
         let device = self.device.clone();
         let error: &dyn crate::solve::MotionError = &program;
+        // Longer than the model makes, or prompts on a timeline: window by window.
+        let timelines: Vec<Vec<crate::solve::long::PromptSpan>> = program
+            .timelines()
+            .into_iter()
+            .zip(&req.prompts)
+            .map(|(line, prompt)| match line.is_empty() {
+                true => vec![crate::solve::long::PromptSpan {
+                    from: 0,
+                    to: frames,
+                    prompt: prompt.clone(),
+                }],
+                false => line
+                    .into_iter()
+                    .map(|t| crate::solve::long::PromptSpan {
+                        from: t.from,
+                        to: t.to,
+                        prompt: t.text,
+                    })
+                    .collect(),
+            })
+            .collect();
         let result = match self.bundle() {
             Err(e) => return Reply::error(e),
-            Ok(bundle) => solve(&Prior::from_bundle(bundle), &req, error, &device, |_| {}),
+            Ok(bundle) => {
+                let prior = Prior::from_bundle(bundle);
+                let windowed = frames > prior.max_frames || timelines.iter().any(|t| t.len() > 1);
+                match (windowed, &req.edit) {
+                    (true, Some(_)) => {
+                        return Reply::error(
+                            "editing a take in windows (longer than the model makes, or a prompt timeline) is not supported",
+                        );
+                    }
+                    (true, None) => {
+                        let long = crate::solve::long::LongRequest {
+                            timelines,
+                            placements: req.placements.clone(),
+                            ..crate::solve::long::LongRequest::new(
+                                Vec::new(),
+                                frames,
+                                seed,
+                                solver.clone(),
+                            )
+                        };
+                        crate::solve::long::solve_long(&prior, &long, error, &device, |_| {})
+                    }
+                    (false, _) => solve(&prior, &req, error, &device, |_| {}),
+                }
+            }
         };
         match result {
             Err(e) => Reply::error(format!("{} failed: {e}", solver.name())),

@@ -275,6 +275,7 @@ fn finish(
     }
     if let Some(edit) = &ctx.edit {
         edit.clean_free_feet(&mut features, ctx.frames);
+        edit.rebuild_seams(&mut features, ctx.frames);
     }
     let per = ctx.frames * FEATURE_DIM;
     let mut motions = Vec::with_capacity(ctx.samples);

@@ -10,8 +10,12 @@
 //!   and falls linearly to 0 over [`Edit::blend`] frames into the edited window, so the
 //!   model continues the kept frames without a pop. A guided solver scales its steps by
 //!   `1 − w` (kept frames do not move), and frames of weight 1 are put back once more at
-//!   the end so they come back exactly (the skeleton projection of `guide`'s late steps
-//!   touches every frame); the seams stay as the chain left them.
+//!   the end so they come back exactly. `guide`'s skeleton projection moves each feature
+//!   by its `1 − w` too ([`Ctx::hold_change`]), and the seams it scaled get their bones
+//!   back ([`EditState::rebuild_seams`]); otherwise the seams stay as the chain left them.
+//! * **Untouched time.** [`auto_hold`] finds the frames no statement reads; `mprog run
+//!   --from` keeps them ([`AutoHold::time_weights`]), easing into the edit over
+//!   [`TIME_MARGIN`] frames before the first frame the program reads.
 //!
 //! * **The path.** [`Edit::hold_path`] holds the take's turning speed and horizontal root
 //!   velocity on every frame the same way, so the body is edited on the take's own path.
@@ -21,7 +25,7 @@
 //! the body (MDM's in-betweening does the same); frames kept before it stay in place.
 //!
 //! Solvers that can edit call [`Ctx::chain_start`], [`Ctx::hold_x0`], [`Ctx::hold_step`]
-//! and [`Ctx::hold_final`]; with no take they change nothing.
+//! (and [`Ctx::hold_change`]) and [`Ctx::hold_final`]; with no take they change nothing.
 
 use super::SolveError;
 use super::cleanup::{FootCleanup, clean_feet};
@@ -34,15 +38,23 @@ use crate::model::noise::NoiseSource;
 use crate::model::sampler::{SamplerKind, ddim_step, guided_x0, posterior_mean, schedule_for};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::objective::MotionError;
-use crate::skeleton::NUM_JOINTS;
+use crate::skeleton::{BONE_LENGTHS, NUM_JOINTS, PARENTS};
 use burn::prelude::*;
 use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Strength when none is given (chosen by measurement: the book's editing chapter).
 pub const DEFAULT_STRENGTH: f32 = 0.5;
 
 /// Default frames of the blend at each seam of a kept window.
 pub const DEFAULT_BLEND: usize = 5;
+
+/// Frames of untouched time next to the frames a program reads that are not held
+/// exactly but ease into the edit ([`AutoHold::time_weights`]), chosen by measurement on
+/// a real walk with the hand on the head in its second half (the book's editing chapter):
+/// with 5 the hand rushed to the head (the wrist's largest acceleration 1.9× the take's),
+/// with 10 it stays near the take's own (1.1×); longer margins hold fewer frames.
+pub const TIME_MARGIN: usize = 10;
 
 /// What to edit and how.
 #[derive(Clone, Debug, PartialEq)]
@@ -142,12 +154,67 @@ pub struct AutoHold {
     pub path: bool,
     /// The [`BODY_PARTS`] the program does not touch, held to the take.
     pub parts: Vec<&'static str>,
+    /// Per frame of the take, whether the program leaves it alone: no statement reads it
+    /// ([`MotionError::active_frames`]) and the error's gradient on the take does not
+    /// reach it. All `false` for an error that cannot say which frames it reads.
+    pub untouched: Vec<bool>,
 }
 
 impl AutoHold {
     /// The held joints of [`Self::parts`].
     pub fn joints(&self) -> [bool; NUM_JOINTS] {
         parts_joints(&self.parts)
+    }
+
+    /// The frame ranges of untouched time held exactly: see [`untouched_ranges`].
+    pub fn kept_time(&self, margin: usize) -> Vec<Range<usize>> {
+        untouched_ranges(&self.untouched, margin)
+    }
+
+    /// Hold weights of the untouched time ([`hold_weights`] of [`Self::kept_time`]): 1 on
+    /// the frames held exactly, easing to 0 over the `margin` frames before the first
+    /// frame the program reads (and after its last), which are therefore free; empty when
+    /// no frame is held.
+    pub fn time_weights(&self, margin: usize) -> Vec<f32> {
+        let keep = self.kept_time(margin);
+        if keep.is_empty() {
+            return Vec::new();
+        }
+        hold_weights(self.untouched.len(), &keep, margin)
+    }
+}
+
+/// The runs of `untouched` frames, each shortened by `margin` frames at every end that
+/// meets a touched frame (not at the motion's ends): the blend of [`hold_weights`] then
+/// lies in the untouched time, and every frame the program reads is free.
+pub fn untouched_ranges(untouched: &[bool], margin: usize) -> Vec<Range<usize>> {
+    let n = untouched.len();
+    let mut out = Vec::new();
+    let mut t = 0;
+    while t < n {
+        if !untouched[t] {
+            t += 1;
+            continue;
+        }
+        let start = t;
+        while t < n && untouched[t] {
+            t += 1;
+        }
+        let lo = if start == 0 { 0 } else { start + margin };
+        let hi = if t == n { n } else { t.saturating_sub(margin) };
+        if lo < hi {
+            out.push(lo..hi);
+        }
+    }
+    out
+}
+
+/// The larger of two per-frame hold weights (empty: nothing held).
+pub fn merge_holds(a: &[f32], b: &[f32]) -> Vec<f32> {
+    match (a.is_empty(), b.is_empty()) {
+        (true, _) => b.to_vec(),
+        (_, true) => a.to_vec(),
+        _ => a.iter().zip(b).map(|(x, y)| x.max(*y)).collect(),
     }
 }
 
@@ -157,9 +224,13 @@ impl AutoHold {
 ///   the take's motion, so the walk stays the same walk and its feet stay planted);
 /// * the path is held unless shifting the whole take sideways changes the error (a program
 ///   about where the body is, such as a region or a target point, may move the path; one
-///   about the body's own shape may not).
+///   about the body's own shape may not);
+/// * a frame is untouched time when no statement reads it (a program about the second
+///   half leaves the first alone) and the gradient does not reach it. A frame inside a
+///   statement's window that the take already meets has no gradient but is read, so it
+///   stays free: the edit may have to move it to meet the frames next to it.
 ///
-/// A program the take already meets touches nothing, and the edit returns the take.
+/// A program the take already meets touches no body part, and the edit returns the take.
 pub fn auto_hold(
     take: &Take,
     error: &dyn MotionError,
@@ -175,13 +246,19 @@ pub fn auto_hold(
     let joints = Tensor::<5>::from_data(TensorData::new(flat.clone(), dims), &ad).require_grad();
     let e = error.error(joints.clone());
     let mut touched = [false; NUM_JOINTS];
+    // A frame is touched when a statement reads it or the gradient reaches it.
+    let mut untouched: Vec<bool> = match error.active_frames(n) {
+        Some(active) if active.len() == n => active.iter().map(|a| !a).collect(),
+        _ => vec![false; n],
+    };
     let grad = e
         .is_tracked()
         .then(|| joints.grad(&e.sum().backward()))
         .flatten();
     if let Some(g) = grad {
+        let g = g.abs();
         let per_joint = host(
-            g.abs()
+            g.clone()
                 .sum_dim(4)
                 .sum_dim(2)
                 .sum_dim(1)
@@ -189,6 +266,10 @@ pub fn auto_hold(
         );
         for (t, g) in touched.iter_mut().zip(per_joint) {
             *t = g > 0.0 || !g.is_finite();
+        }
+        let per_frame = host(g.sum_dim(4).sum_dim(3).sum_dim(1).reshape([n]));
+        for (u, g) in untouched.iter_mut().zip(per_frame) {
+            *u &= g == 0.0;
         }
     }
     let total = |offset: [f32; 3]| -> f32 {
@@ -207,7 +288,11 @@ pub fn auto_hold(
         .filter(|(_, joints)| !joints.iter().any(|&j| touched[j]))
         .map(|(name, _)| *name)
         .collect();
-    Ok(AutoHold { path, parts })
+    Ok(AutoHold {
+        path,
+        parts,
+        untouched,
+    })
 }
 
 /// The feature columns that belong to joint `j`: its root-relative position and rotation,
@@ -290,6 +375,11 @@ pub struct EditState {
     exact: Option<Tensor<3>>,
     /// `[N, 263]` `1 − w`, the share of a step each frame's feature takes (empty: all 1).
     free: Vec<f32>,
+    /// Per frame, whether it is a seam: held in part (0 < w < 1).
+    seams: Vec<bool>,
+    /// Whether a change was scaled on the seams ([`Ctx::hold_change`]: `guide`'s skeleton
+    /// projection), so their bones want rebuilding ([`EditState::rebuild_seams`]).
+    scaled: AtomicBool,
 }
 
 impl EditState {
@@ -344,6 +434,8 @@ impl EditState {
             hold,
             exact,
             free,
+            seams: edit.hold.iter().map(|w| *w > 0.0 && *w < 1.0).collect(),
+            scaled: AtomicBool::new(false),
         }
     }
 }
@@ -367,6 +459,68 @@ impl EditState {
                 *f += (b - *f) * w;
             }
         }
+    }
+}
+
+impl EditState {
+    /// The seam frames of the denormalised `[B·P, N, 263]` result (`frames` per motion)
+    /// rebuilt from the pelvis outwards, each joint the chain made keeping its bone's
+    /// direction and taking the skeleton's length; joints held on the frame stay as they
+    /// are. Only after a solver's skeleton projection was scaled there
+    /// ([`Ctx::hold_change`]): such a seam frame is part take and part projected edit, a
+    /// blend of two poses whose bones are short (the left collar of a walk 6–8 cm short at
+    /// a `--keep` seam); a blend of bone directions is a pose. A solver that projects
+    /// nothing (`plain`) is left as it made the seams, like the rest of its motion.
+    pub fn rebuild_seams(&self, features: &mut [f32], frames: usize) {
+        if self.strength == 0.0
+            || !self.scaled.load(Ordering::Relaxed)
+            || !self.seams.iter().any(|s| *s)
+        {
+            return;
+        }
+        for (k, row) in features.chunks_exact_mut(FEATURE_DIM).enumerate() {
+            let t = k % frames;
+            if !self.seams.get(t).copied().unwrap_or(false) {
+                continue;
+            }
+            let held = |j: usize| {
+                self.free
+                    .get(t * FEATURE_DIM + RIC.start + 3 * (j - 1))
+                    .is_some_and(|f| *f <= 0.0)
+            };
+            rebuild_bones(row, held);
+        }
+    }
+}
+
+/// A feature row's joints (the ric block, the pelvis at the root height) rebuilt from the
+/// pelvis outwards: each joint `held` does not name sits at its parent plus its own bone's
+/// direction times the skeleton's length.
+fn rebuild_bones(row: &mut [f32], held: impl Fn(usize) -> bool) {
+    let at = |row: &[f32], j: usize| -> [f32; 3] {
+        if j == 0 {
+            [0.0, row[ROOT_Y.start], 0.0]
+        } else {
+            let c = RIC.start + 3 * (j - 1);
+            [row[c], row[c + 1], row[c + 2]]
+        }
+    };
+    let old: Vec<[f32; 3]> = (0..NUM_JOINTS).map(|j| at(row, j)).collect();
+    let mut new = old.clone();
+    for j in 1..NUM_JOINTS {
+        if held(j) {
+            continue;
+        }
+        let parent = PARENTS[j];
+        let d: Vec<f32> = (0..3).map(|a| old[j][a] - old[parent][a]).collect();
+        let len = d.iter().map(|v| v * v).sum::<f32>().sqrt();
+        if len < 1e-6 {
+            continue;
+        }
+        let scale = BONE_LENGTHS[j] / len;
+        new[j] = std::array::from_fn(|a| new[parent][a] + d[a] * scale);
+        let c = RIC.start + 3 * (j - 1);
+        row[c..c + 3].copy_from_slice(&new[j]);
     }
 }
 
@@ -568,6 +722,31 @@ impl Ctx<'_> {
         }
     }
 
+    /// Scales the change a step made, `before` → `after` over `[B·P, N, width]` rows, by
+    /// each feature's `1 − w`, as [`Ctx::hold_step`] scales a step: for a change that is
+    /// not a gradient step (`guide`'s skeleton projection). Free features keep `after`
+    /// exactly; without a take nothing changes.
+    pub fn hold_change(&self, before: &[f32], after: &mut [f32], width: usize) {
+        let Some(edit) = self.edit.as_ref().filter(|e| !e.free.is_empty()) else {
+            return;
+        };
+        edit.scaled.store(true, Ordering::Relaxed);
+        let free = &edit.free;
+        for (k, (row, old)) in after
+            .chunks_exact_mut(width)
+            .zip(before.chunks_exact(width))
+            .enumerate()
+        {
+            let t = k % self.frames;
+            let f = &free[t * FEATURE_DIM..t * FEATURE_DIM + width];
+            for ((x, b), s) in row.iter_mut().zip(old).zip(f) {
+                if *s < 1.0 {
+                    *x = b + (*x - b) * s;
+                }
+            }
+        }
+    }
+
     /// The unguided chain of `kind` over the edit (started at its strength, kept frames
     /// held); [`Ctx::sample_plain`] without a take.
     pub fn sample_edited(
@@ -653,5 +832,69 @@ mod tests {
         assert_eq!(&w[16..], &[1.0; 4]);
         // Blend 0: a hard switch.
         assert_eq!(hold_weights(4, &[1..2], 0), vec![0.0, 1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn a_seam_blend_of_two_poses_gets_its_bones_back() {
+        use crate::skeleton::rest_pose;
+        // The rest pose, and the same with the left arm swung up (about the shoulder).
+        let a = rest_pose();
+        let mut b = a;
+        let turn = glam::Quat::from_rotation_z(1.5);
+        for j in [18, 20] {
+            b[j] = a[16] + turn * (a[j] - a[16]);
+        }
+        let row_of = |p: &[glam::Vec3; NUM_JOINTS]| {
+            let mut row = vec![0.0f32; FEATURE_DIM];
+            row[ROOT_Y.start] = p[0].y;
+            for (c, v) in row[RIC].chunks_exact_mut(3).zip(&p[1..]) {
+                c.copy_from_slice(&v.to_array());
+            }
+            row
+        };
+        let (ra, rb) = (row_of(&a), row_of(&b));
+        let mut row: Vec<f32> = ra.iter().zip(&rb).map(|(x, y)| 0.5 * (x + y)).collect();
+        let joint = |row: &[f32], j: usize| match j {
+            0 => glam::Vec3::new(0.0, row[ROOT_Y.start], 0.0),
+            _ => glam::Vec3::from_slice(&row[RIC.start + 3 * (j - 1)..RIC.start + 3 * j]),
+        };
+        let bone = |row: &[f32], j: usize| (joint(row, j) - joint(row, PARENTS[j])).length();
+        assert!(
+            (bone(&row, 20) - BONE_LENGTHS[20]).abs() > 0.05,
+            "the blend is short"
+        );
+        let right_wrist = joint(&row, 21);
+        rebuild_bones(&mut row, |j| j == 21);
+        for (j, len) in BONE_LENGTHS.iter().enumerate().skip(1) {
+            if j != 21 {
+                assert!((bone(&row, j) - len).abs() < 1e-4, "joint {j}");
+            }
+        }
+        assert_eq!(joint(&row, 21), right_wrist, "a held joint stays");
+        // Between the two poses: the wrist's direction from the elbow is the blend's.
+        let elbow = joint(&row, 18);
+        let dir = (joint(&row, 20) - elbow).normalize();
+        let want = ((a[20] - a[18]) + (b[20] - b[18])).normalize();
+        assert!(dir.dot(want) > 0.999, "{dir} vs {want}");
+    }
+
+    #[test]
+    fn untouched_time_is_held_short_of_what_the_program_reads() {
+        let u = |s: &str| s.chars().map(|c| c == '.').collect::<Vec<bool>>();
+        // Untouched runs at the motion's ends keep those ends; where they meet a read
+        // frame they stop `margin` short of it.
+        assert_eq!(untouched_ranges(&u("......xxxx......"), 2), [0..4, 12..16]);
+        // A run between two windows loses the margin on both sides; one too short is free.
+        assert_eq!(untouched_ranges(&u("xx......xx...xx"), 2), [4..6]);
+        assert!(untouched_ranges(&u("xxxx"), 2).is_empty());
+        assert_eq!(untouched_ranges(&u("...."), 2), [0..4]);
+        assert_eq!(untouched_ranges(&u("..x"), 0), [0..2]);
+        // Time holds and kept windows: the larger weight wins; empty is nothing held.
+        assert_eq!(
+            merge_holds(&[1.0, 0.5, 0.0], &[0.0, 0.75, 0.0]),
+            [1.0, 0.75, 0.0]
+        );
+        assert_eq!(merge_holds(&[], &[0.5]), [0.5]);
+        assert_eq!(merge_holds(&[0.5], &[]), [0.5]);
     }
 }

@@ -59,6 +59,16 @@ fn guide() -> Solver {
     })
 }
 
+/// `lbfgs` at a size the tiny model runs in a moment.
+fn lbfgs() -> Solver {
+    Solver::new(LbfgsConfig {
+        steps: 40,
+        late_steps: 5,
+        k_last: 10,
+        ..LbfgsConfig::default()
+    })
+}
+
 /// `latent` at a size the tiny model runs in a moment.
 fn latent() -> Solver {
     Solver::new(LatentConfig {
@@ -141,6 +151,7 @@ fn kept_frames_come_back_exactly_and_the_rest_is_edited() {
     for solver in [
         guide(),
         latent(),
+        lbfgs(),
         Solver::plain(crate::model::sampler::SamplerKind::Ddim(20)),
     ] {
         let name = solver.name();
@@ -257,7 +268,7 @@ fn solvers_that_cannot_edit_say_so_and_bad_edits_are_refused() {
             Ok(_) => panic!("{} accepted a bad edit", req.solver.name()),
         }
     };
-    for name in ["ik", "ik-reg", "lbfgs"] {
+    for name in ["ik", "ik-reg"] {
         let m = refused(&request(
             Solver::by_name(name).unwrap(),
             edit(0.5, Vec::new()),
@@ -395,4 +406,112 @@ fn foot_cleanup_leaves_what_is_held_exactly() {
         "kept frames moved"
     );
     assert!(row_gap(&clean.features, &raw.features, 6..N) > 0.0);
+}
+
+/// The left wrist above 1.6 m on frames `from..` only: a program about the second half,
+/// which says which frames it reads as a program does.
+struct WristUpFrom(usize);
+
+impl MotionError for WristUpFrom {
+    fn error(&self, j: Tensor<5>) -> Tensor<1> {
+        let n = j.dims()[2];
+        wrist_up(j.narrow(2, self.0, n - self.0))
+    }
+
+    fn active_frames(&self, frames: usize) -> Option<Vec<bool>> {
+        Some((0..frames).map(|t| t >= self.0).collect())
+    }
+}
+
+#[test]
+fn untouched_time_is_the_frames_no_statement_reads() {
+    let take = Take::encode(&[take_walk()]).unwrap();
+    let device = Device::flex();
+    let auto = auto_hold(&take, &WristUpFrom(8), &device).unwrap();
+    let want: Vec<bool> = (0..N).map(|t| t < 8).collect();
+    assert_eq!(auto.untouched, want);
+    // Held exactly 2 frames short of frame 8; the 2 frames before it ease into the edit.
+    assert_eq!(auto.kept_time(2), [0..6]);
+    let w = auto.time_weights(2);
+    assert_eq!(&w[..6], &[1.0; 6]);
+    assert!(
+        w[6] > w[7] && w[7] > 0.0 && w[8..].iter().all(|v| *v == 0.0),
+        "{w:?}"
+    );
+    // Frames a statement reads are not untouched even where the take already meets it (no
+    // gradient there): the edit may need them.
+    struct Met(WristUpFrom);
+    impl MotionError for Met {
+        fn error(&self, j: Tensor<5>) -> Tensor<1> {
+            self.0.error(j) * 0.0
+        }
+        fn active_frames(&self, frames: usize) -> Option<Vec<bool>> {
+            self.0.active_frames(frames)
+        }
+    }
+    let auto = auto_hold(&take, &Met(WristUpFrom(8)), &device).unwrap();
+    assert_eq!(auto.untouched, want);
+    // An error that cannot say which frames it reads holds no time, even where its
+    // gradient is zero; nor does one that reads every frame.
+    let auto = auto_hold(&take, &|j: Tensor<5>| WristUpFrom(8).error(j), &device).unwrap();
+    assert!(auto.untouched.iter().all(|u| !u) && auto.time_weights(2).is_empty());
+    let auto = auto_hold(&take, &WristUpFrom(0), &device).unwrap();
+    assert!(auto.kept_time(2).is_empty());
+}
+
+/// The largest distance of any joint from the take's on frames `frames`, in the world.
+fn world_gap(got: &Motion, want: &Motion, frames: std::ops::Range<usize>) -> f32 {
+    frames
+        .flat_map(|t| (0..NUM_JOINTS).map(move |j| (t, j)))
+        .map(|(t, j)| (got.frames[t][j] - want.frames[t][j]).length())
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn untouched_time_stays_the_takes_and_free_time_lets_it_move() {
+    let bundle = tiny_bundle();
+    let error = WristUpFrom(8);
+    let e = edit(1.0, Vec::new());
+    let want = e.take.motions().unwrap().remove(0);
+    let auto = auto_hold(&e.take, &error, &Device::flex()).unwrap();
+    let margin = 2;
+    let run = |hold: Vec<f32>| {
+        let req = request(guide(), Edit { hold, ..e.clone() });
+        solve(
+            &Prior::from_bundle(&bundle),
+            &req,
+            &error,
+            &Device::flex(),
+            |_| {},
+        )
+        .unwrap()
+    };
+    // Held (the default of `run --from`): frames 0..6 are the take's, to the millimetre
+    // (the 2 cm the issue allows is far above it), and the frames the program reads move.
+    let held = run(auto.time_weights(margin));
+    let m = &held.motions[0][0];
+    let kept = auto.kept_time(margin)[0].clone();
+    assert_eq!(kept, 0..6);
+    let gap = world_gap(m, &want, kept.clone());
+    assert!(gap < 0.02, "untouched time moved {gap} m");
+    assert!(gap < 1e-3, "untouched time moved {gap} m");
+    assert!(
+        world_gap(m, &want, 8..N) > 1e-2,
+        "the second half was not edited"
+    );
+    let take_error = error
+        .error(Tensor::from_data(
+            TensorData::new(want.to_flat(), [1, 1, N, NUM_JOINTS, 3]),
+            &Device::flex(),
+        ))
+        .into_scalar::<f32>();
+    assert!(
+        held.error[0] < take_error,
+        "{} vs {take_error}",
+        held.error[0]
+    );
+    // `--free-time` (no time held): the untouched frames are the model's again.
+    let free = run(Vec::new());
+    let gap = world_gap(&free.motions[0][0], &want, kept);
+    assert!(gap > 0.02, "free time moved only {gap} m");
 }

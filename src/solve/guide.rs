@@ -505,9 +505,17 @@ fn guide_fused(
     }
     objective.unlock_feet();
     if skeleton {
-        // The error was of P(head): make that what the chain carries on with.
+        // The error was of P(head): make that what the chain carries on with, as far as
+        // each feature of a take is free (`1 − w`). P squares the shoulders into its rigid
+        // T, which a take's need not be (a retargeted walk's collars 0.10 m apart, P's
+        // 0.30 m): applied in full on a seam's frames it moved the left collar 0.2 m in
+        // the one frame after the last held one.
+        let before = ctx.edit.is_some().then(|| head.clone());
         objective.apply_projection(&mut head);
         objective.stop_projecting();
+        if let Some(before) = before {
+            ctx.hold_change(&before, &mut head, HEAD);
+        }
     }
     insert_head(full, FEATURE_DIM, &head);
     Ok(values)

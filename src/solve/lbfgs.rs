@@ -166,13 +166,14 @@ fn run(
     let cond = ctx.condition(&ctx.device);
     let mut noise = ctx.step_noise();
     let dims = ctx.dims();
-    let n = schedule.len();
     let optimiser = LBFGSConfig::new()
         .with_history_size(cfg.history)
         .with_max_iter(cfg.max_iter)
         .with_line_search_fn(LineSearchFn::StrongWolfe);
     let mut objective = ctx.host_objective();
-    let mut x = ctx.initial_tensor(&ctx.device);
+    // A take starts the chain part-way down and holds its kept frames (`super::edit`).
+    let (n, mut x) = ctx.chain_start(&schedule);
+    let mut steps = ctx.chain_steps(n);
     let mut trace = Vec::with_capacity(n);
     let early_mask = cfg.early_root_only.then(|| root_mask(&ctx.device));
     let mut realism = Realism::new(
@@ -181,13 +182,24 @@ fn run(
         cfg.realism_shared,
         cfg.realism_every,
     );
-    for i in (0..n).rev() {
-        let x0 = realism.x0(&den, x.clone(), schedule.timesteps[i], &cond, true);
+    while let Some(i) = steps.next_step() {
+        let x0 = ctx.hold_x0(realism.x0(&den, x.clone(), schedule.timesteps[i], &cond, true));
         let mu = posterior_mean(&schedule, i, x, x0);
         let before = (realism.is_on() && (cfg.k_first > 0 || cfg.k_last > 0)).then(|| host(mu.clone()));
         let at = || format!("denoising step {}/{n}", n - i);
         let problem = StepProblem::at(ctx, cfg, i, &ad, early_mask.as_ref(), &at);
+        let held = ctx.edit.is_some().then(|| host(mu.clone()));
         let (mu, last) = problem.solve(cfg, &optimiser, &mut objective, mu)?;
+        // Kept frames do not move: the step L-BFGS took, scaled by each feature's 1 − w.
+        let mu = match held {
+            Some(from) => {
+                let mut step: Vec<f32> = host(mu).iter().zip(&from).map(|(a, b)| a - b).collect();
+                ctx.hold_step(&mut step, FEATURE_DIM);
+                let moved: Vec<f32> = from.iter().zip(&step).map(|(b, d)| b + d).collect();
+                Tensor::from_data(TensorData::new(moved, dims), &ctx.device)
+            }
+            None => mu,
+        };
         let values = last.map(|last| {
             let m = mean(&last);
             trace.push(last);
@@ -202,15 +214,16 @@ fn run(
         } else {
             mu
         };
+        x = steps.after(&schedule, x, &mut noise, &ctx.device);
         progress(Progress {
             phase: Phase::Sampling,
-            done: n - i,
-            total: n,
+            done: steps.ran(),
+            total: steps.total(),
             error: values,
         });
     }
     Ok(Outcome {
-        x: host(x),
+        x: host(ctx.hold_final(x)),
         relax: None,
         trace,
     })
@@ -502,6 +515,6 @@ impl SolverConfig for LbfgsConfig {
         run(ctx, self, progress)
     }
     fn edit_refusal(&self) -> Option<&'static str> {
-        Some("holding kept frames inside its L-BFGS steps is not implemented")
+        None
     }
 }

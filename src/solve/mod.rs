@@ -60,6 +60,7 @@ pub mod envelope;
 pub mod feet;
 pub mod host;
 pub mod knobs;
+pub mod long;
 mod realism;
 pub mod reference;
 mod request;
@@ -102,8 +103,8 @@ pub use crate::scene::{DEFAULT_SPACING, Placement};
 pub use decode::{Decoder, RigidTensors};
 pub use driver::{Ctx, Outcome, solve};
 pub use edit::{
-    AutoHold, BODY_PARTS, DEFAULT_BLEND, DEFAULT_RESAMPLE, DEFAULT_STRENGTH, Edit, auto_hold,
-    hold_weights, in_between_hold, parts_joints,
+    AutoHold, BODY_PARTS, DEFAULT_BLEND, DEFAULT_RESAMPLE, DEFAULT_STRENGTH, Edit, TIME_MARGIN,
+    auto_hold, hold_weights, in_between_hold, merge_holds, parts_joints, untouched_ranges,
 };
 pub use guide::{FusedSettings, GuideConfig, StepRule, VarianceRule};
 pub use ik::IkConfig;

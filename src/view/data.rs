@@ -6,15 +6,16 @@
 //!  "joint_names": […22], "parents": […22], "chains": [[0,2,5,8,11], …],
 //!  "chain_sides": ["right", "left", "centre", "right", "left"],
 //!  "people": [{"name": "person 1", "frames": 120, "mm": [x0, y0, z0, …]}],
-//!  "overlays": […], "contacts": […], "statement_errors": […]}
+//!  "overlays": […], "contacts": […], "statement_errors": […],
+//!  "timeline": [[{"from": 0, "to": 160, "prompt": "…"}, …], …]}
 //! ```
 //!
 //! `mm` holds `frames × 22 × 3` integers: frame 0 in millimetres, then every later frame
 //! as the millimetre difference from the one before (small numbers, so a 10 s clip is a
-//! few tens of kB). Overlays, contacts and statement errors use the schema of
+//! few tens of kB). Overlays, contacts, statement errors and the timeline use the schema of
 //! [`super::schema`], with joints as indices and values rounded to 4 significant digits.
 
-use super::schema::{Contact, StatementError, ViewExtras, overlays_to_meta};
+use super::schema::{Contact, StatementError, ViewExtras, overlays_to_meta, timeline_to_meta};
 use crate::motion::Motion;
 use crate::skeleton::{JOINT_NAMES, KINEMATIC_CHAINS, NUM_JOINTS, PARENTS};
 use serde_json::{Value, json};
@@ -51,6 +52,7 @@ pub(crate) fn data_block(
         "overlays": overlays_to_meta(&extras.overlays),
         "contacts": extras.contacts.iter().map(contact).collect::<Vec<_>>(),
         "statement_errors": extras.statement_errors.iter().map(statement).collect::<Vec<_>>(),
+        "timeline": timeline_to_meta(&extras.timeline),
     })
 }
 

@@ -10,6 +10,9 @@
 //!   when inactive, bright when the frame is in range) and, from `meta.statement_errors`,
 //!   one small chart per statement under the canvas with a cursor at the current frame
 //!   (schema: [`schema`]);
+//! * from `meta.timeline`, a bar under the time slider with one segment per prompt (one
+//!   row per person; click to seek), the prompt active at the current frame next to the
+//!   frame counter, and the spans shaded in the error charts;
 //! * play/pause, a time slider with frame counter and seconds, speed control, and keys:
 //!   space (play/pause), ← / → (one frame; with shift ten), ↑ / ↓ (speed), Home / End,
 //!   R (reset the camera).
@@ -38,8 +41,9 @@ pub mod schema;
 mod tests;
 
 pub use schema::{
-    Contact, JointOf, StatementError, ViewExtras, contacts_to_meta, extras_from_meta,
-    overlays_from_meta, overlays_to_meta, statement_errors_to_meta,
+    Contact, JointOf, StatementError, TimelineSpan, ViewExtras, contacts_to_meta, extras_from_meta,
+    overlays_from_meta, overlays_to_meta, statement_errors_to_meta, timeline_from_meta,
+    timeline_to_meta,
 };
 
 use crate::motion::Meta;

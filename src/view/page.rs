@@ -31,12 +31,14 @@ pub(crate) fn page(title: &str, data: &Value) -> String {
   <button id="play" type="button" title="play / pause (space)">&#9654;</button>
   <input id="slider" type="range" min="0" max="0" value="0" step="1" aria-label="frame">
   <span id="counter" class="mono"></span>
+  <span id="prompt" title="the prompt at this frame"></span>
   <label>speed <select id="speed" title="speed (up / down arrows)">
     <option value="0.25">0.25&times;</option><option value="0.5">0.5&times;</option>
     <option value="1" selected>1&times;</option><option value="2">2&times;</option>
     <option value="4">4&times;</option></select></label>
   <button id="reset" type="button" title="reset the camera (R)">reset view</button>
 </div>
+<div id="timeline"></div>
 <div id="charts"></div>
 <footer>drag: orbit &middot; shift-drag: pan &middot; wheel: zoom &middot; space: play/pause &middot;
 &larr; &rarr;: step (shift: 10) &middot; &uarr; &darr;: speed &middot; Home/End &middot; R: reset view

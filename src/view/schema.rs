@@ -1,7 +1,8 @@
 //! The `meta` fields the viewer draws, read and checked: `meta.overlays` (program
 //! geometry, the same primitives as [`render::Overlay`](crate::render::Overlay)),
 //! `meta.contacts` (joint pairs between people over frame ranges) and
-//! `meta.statement_errors` (one error curve per program statement).
+//! `meta.statement_errors` (one error curve per program statement) and `meta.timeline`
+//! (each person's prompts over time, as `mprog run` writes them).
 //!
 //! Schema (metres, world coordinates, Y up; frames are 0-based and inclusive):
 //!
@@ -21,6 +22,10 @@
 //!   "statement_errors": [
 //!     {"label": "line 3: hands apart", "line": 3, "unit": "m", "tolerance": 0.05,
 //!      "values": [0.21, 0.18, null, …]}
+//!   ],
+//!   "timeline": [
+//!     [{"from": 0, "to": 160, "prompt": "a person walks forward"},
+//!      {"from": 160, "to": 400, "prompt": "a person sits down"}]
 //!   ]
 //! }
 //! ```
@@ -30,6 +35,9 @@
 //! * `values` has one entry per frame of the longest person; `null` marks frames where the
 //!   statement does not apply. `line`, `unit`, `tolerance` and `label` of a contact are
 //!   optional.
+//! * `timeline` has one list per person (in order; at most one per person, an empty list
+//!   for a person without one) of spans covering frames `from ≤ t < to`; a span must
+//!   start inside the motion, and one ending past it is cut at its end.
 //! * Unknown fields and kinds are errors (a typo must not silently hide geometry); every
 //!   error names the entry, e.g. `meta.overlays[2]: …`.
 //!
@@ -38,6 +46,7 @@
 
 use super::ViewError;
 use crate::motion::Meta;
+pub use crate::render::TimelineSpan;
 pub use crate::scene::{Contact, JointOf, Overlay};
 use crate::skeleton::{JOINT_NAMES, NUM_JOINTS, joint_index};
 use glam::{Vec2, Vec3};
@@ -62,6 +71,8 @@ pub struct StatementError {
 /// Everything the viewer draws besides the people.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ViewExtras {
+    /// `meta.timeline`.
+    pub timeline: Vec<Vec<TimelineSpan>>,
     /// `meta.overlays`.
     pub overlays: Vec<Overlay>,
     /// `meta.contacts`.
@@ -133,6 +144,14 @@ struct StatementDoc {
     values: Vec<Option<f64>>,
 }
 
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpanDoc {
+    from: usize,
+    to: usize,
+    prompt: String,
+}
+
 /// Reads and checks the viewer's fields of `meta` against `people` people and `frames`
 /// frames (of the longest person). Missing fields are empty lists.
 pub fn extras_from_meta(
@@ -141,6 +160,7 @@ pub fn extras_from_meta(
     frames: usize,
 ) -> Result<ViewExtras, ViewError> {
     Ok(ViewExtras {
+        timeline: timeline_from_meta(meta, people, frames)?,
         overlays: overlays_from_meta(meta)?,
         contacts: entries(meta, "contacts", |i, doc: ContactDoc| {
             contact(doc, people, frames).map_err(|m| bad("contacts", i, m))
@@ -156,6 +176,64 @@ pub fn overlays_from_meta(meta: &Meta) -> Result<Vec<Overlay>, ViewError> {
     entries(meta, "overlays", |i, doc: OverlayDoc| {
         overlay(doc).map_err(|m| bad("overlays", i, m))
     })
+}
+
+/// Reads and checks `meta.timeline` against `people` people and `frames` frames (for
+/// pictures as well as the page); missing, it is empty.
+pub fn timeline_from_meta(
+    meta: &Meta,
+    people: usize,
+    frames: usize,
+) -> Result<Vec<Vec<TimelineSpan>>, ViewError> {
+    let lines = entries(meta, "timeline", |i, docs: Vec<SpanDoc>| {
+        docs.into_iter()
+            .map(|d| {
+                if d.from >= d.to {
+                    Err(format!("span {}..{} is empty", d.from, d.to))
+                } else if d.from >= frames {
+                    Err(format!(
+                        "span {}..{} starts past the motion's {frames} frames",
+                        d.from, d.to
+                    ))
+                } else {
+                    Ok(TimelineSpan {
+                        from: d.from,
+                        to: d.to.min(frames),
+                        prompt: d.prompt,
+                    })
+                }
+            })
+            .collect::<Result<Vec<_>, String>>()
+            .map_err(|m| bad("timeline", i, m))
+    })?;
+    if lines.len() > people {
+        return Err(ViewError::BadMeta {
+            field: "meta.timeline".into(),
+            message: format!(
+                "{} timelines for {people} {}",
+                lines.len(),
+                if people == 1 { "person" } else { "people" }
+            ),
+        });
+    }
+    Ok(lines)
+}
+
+/// `timeline` (one list of spans per person) in the `meta.timeline` schema.
+pub fn timeline_to_meta(timeline: &[Vec<TimelineSpan>]) -> Value {
+    let docs: Vec<Vec<SpanDoc>> = timeline
+        .iter()
+        .map(|line| {
+            line.iter()
+                .map(|s| SpanDoc {
+                    from: s.from,
+                    to: s.to,
+                    prompt: s.prompt.clone(),
+                })
+                .collect()
+        })
+        .collect();
+    serde_json::to_value(docs).unwrap_or(Value::Null)
 }
 
 /// `overlays` in the `meta.overlays` schema.

@@ -270,6 +270,22 @@ fn malformed_extras_name_the_entry() {
             json!({"statement_errors": [{"values": [0,0,0,0,0,0,0,0,0,0]}]}),
             "missing field `label`",
         ),
+        (
+            json!({"timeline": [[{"from": 4, "to": 4, "prompt": "x"}]]}),
+            "meta.timeline[0]: span 4..4 is empty",
+        ),
+        (
+            json!({"timeline": [[{"from": 0, "to": 5, "prompt": "x"}, {"from": 10, "to": 12, "prompt": "y"}]]}),
+            "meta.timeline[0]: span 10..12 starts past the motion's 10 frames",
+        ),
+        (
+            json!({"timeline": [[], [], []]}),
+            "meta.timeline: 3 timelines for 2 people",
+        ),
+        (
+            json!({"timeline": [{"from": 0, "to": 5, "prompt": "x"}]}),
+            "meta.timeline[0]: invalid type",
+        ),
     ];
     for (m, want) in cases {
         let err = html_string(&two_walkers(10), &meta(m.clone()), "x").unwrap_err();
@@ -319,4 +335,32 @@ fn people_of_different_lengths_share_the_longest_timeline() {
     let d = data_of(&html_string(&people, &m, "x").unwrap());
     assert_eq!(d["frames"], 30);
     assert_eq!(d["people"][1]["frames"], 12);
+}
+
+#[test]
+fn the_timeline_is_embedded_with_its_bar_and_prompt_line() {
+    let people = two_walkers(60);
+    let m = meta(json!({"timeline": [
+        [{"from": 0, "to": 30, "prompt": "a person walks forward"},
+         {"from": 25, "to": 80, "prompt": "a person sits down"}],
+        []
+    ]}));
+    let html = html_string(&people, &m, "timeline").unwrap();
+    let d = data_of(&html);
+    // Cut to the motion's 60 frames; the second person has none.
+    assert_eq!(
+        d["timeline"],
+        json!([[{"from": 0, "to": 30, "prompt": "a person walks forward"},
+                {"from": 25, "to": 60, "prompt": "a person sits down"}], []])
+    );
+    assert!(html.contains(r#"<div id="timeline"></div>"#));
+    assert!(html.contains(r#"<span id="prompt""#));
+    // Read back as the pictures read it; without one it is empty.
+    let lines = timeline_from_meta(&m, 2, 60).unwrap();
+    assert_eq!(lines[0][1].to, 60);
+    assert_eq!(timeline_to_meta(&lines), d["timeline"]);
+    assert_eq!(
+        data_of(&html_string(&people, &Meta::new(), "x").unwrap())["timeline"],
+        json!([])
+    );
 }

@@ -1,6 +1,7 @@
 // mprog viewer: decodes the page's data block (see src/view/data.rs) and plays it on a 2-D
 // canvas through a small perspective camera (orbit, zoom, pan), with a floor grid, stick
-// figures, shadows, root trails, overlays, contacts and per-statement error charts.
+// figures, shadows, root trails, overlays, contacts, the prompt timeline and per-statement
+// error charts.
 // Self-contained: no network, no libraries.
 (function () {
   "use strict";
@@ -15,6 +16,8 @@
     ["#af5f00", "#fabe5a", "#dc8c1e"]
   ];
   var OVERLAY = "#d20096", CONTACT = "#ff8200";
+  // Prompt spans, cycled along a timeline (as in the GIF and PNG renders).
+  var SPAN_COLORS = ["#4285f4", "#34a853", "#f57c00", "#ab47bc", "#0096aa", "#d32f2f"];
 
   function $(id) { return document.getElementById(id); }
 
@@ -317,6 +320,86 @@
     drawDepthSorted(f);
   }
 
+  // ---- prompt timeline ----------------------------------------------------------------------
+  // One row per person with spans; shown when some person has more than one prompt.
+  var tlRows = [];
+  (D.timeline || []).forEach(function (spans, p) {
+    if (spans.length && people[p]) tlRows.push({ name: people[p].name, spans: spans });
+  });
+  if (!tlRows.some(function (r) { return r.spans.length > 1; })) tlRows = [];
+  // x of a frame boundary b (between frames b - 1 and b) on a chart or bar w pixels wide.
+  function edgeX(b, w) { return clamp(6 + (N > 1 ? (b - 0.5) / (N - 1) : 0.5) * (w - 12), 6, w - 6); }
+  function activeText(row, f) {
+    var on = row.spans.filter(function (s) { return f >= s.from && f < s.to; });
+    return on.length ? on.map(function (s) { return "\u201c" + s.prompt + "\u201d"; }).join(" \u2192 ") : "\u2013";
+  }
+  function promptAt(f) {
+    if (tlRows.length === 1) return activeText(tlRows[0], f);
+    return tlRows.map(function (r) { return r.name + ": " + activeText(r, f); }).join(" \u00b7 ");
+  }
+  var TL_ROW = 22, tlCanvas = null;
+  if (tlRows.length) {
+    var tlBox = $("timeline"), tlHead = document.createElement("div");
+    tlHead.className = "head";
+    tlHead.textContent = "prompts over time" + (tlRows.length > 1 ? " (one row per person)" : "");
+    tlCanvas = document.createElement("canvas");
+    tlCanvas.style.height = (tlRows.length * TL_ROW + 4) + "px";
+    tlBox.appendChild(tlHead); tlBox.appendChild(tlCanvas);
+    seekOnDrag(tlCanvas, function (x) {
+      return Math.round(clamp((x - 6) / Math.max(1, tlCanvas.clientWidth - 12), 0, 1) * (N - 1));
+    });
+  }
+  function drawTimeline(f) {
+    if (!tlCanvas) return;
+    var cv = tlCanvas, w = cv.clientWidth, h = cv.clientHeight, dpr = window.devicePixelRatio || 1;
+    if (cv.width !== Math.round(w * dpr) || cv.height !== Math.round(h * dpr)) { cv.width = Math.round(w * dpr); cv.height = Math.round(h * dpr); }
+    var g = cv.getContext("2d");
+    g.setTransform(dpr, 0, 0, dpr, 0, 0);
+    g.clearRect(0, 0, w, h);
+    g.font = "12px system-ui, sans-serif"; g.textBaseline = "middle"; g.textAlign = "left";
+    tlRows.forEach(function (row, r) {
+      var y0 = 2 + r * TL_ROW, rh = TL_ROW - 3;
+      row.spans.forEach(function (s, i) {
+        var on = f >= s.from && f < s.to, c = SPAN_COLORS[i % SPAN_COLORS.length];
+        var a = edgeX(s.from, w), b = edgeX(s.to, w);
+        // Where it blends with the span before, each fills half the row.
+        var prev = row.spans[i - 1], blend = prev && prev.to > s.from ? edgeX(Math.min(prev.to, s.to), w) - a : 0;
+        g.globalAlpha = 1; g.fillStyle = "#fff"; g.fillRect(a, y0, blend, rh);
+        g.globalAlpha = on ? 0.55 : 0.25; g.fillStyle = c; g.fillRect(a, y0, Math.max(1, b - a), rh);
+        if (blend > 0) {
+          var pOn = f >= prev.from && f < prev.to;
+          g.globalAlpha = 1; g.fillStyle = "#fff"; g.fillRect(a, y0, blend, rh / 2);
+          g.globalAlpha = pOn ? 0.55 : 0.25; g.fillStyle = SPAN_COLORS[(i - 1) % SPAN_COLORS.length];
+          g.fillRect(a, y0, blend, rh / 2);
+        }
+        g.globalAlpha = 1; g.fillStyle = c; g.fillRect(a, y0, 1, rh);
+      });
+      row.spans.forEach(function (s, i) {
+        var prev = row.spans[i - 1], next = row.spans[i + 1];
+        var from = prev ? Math.max(s.from, prev.to) : s.from, to = next ? Math.min(s.to, next.from) : s.to;
+        var a = edgeX(from, w) + 4, room = edgeX(Math.max(to, from), w) - 3 - a;
+        var label = (i === 0 && tlRows.length > 1 ? row.name + ": " : "") + s.prompt;
+        if (room < 14) return;
+        while (label.length > 1 && g.measureText(label).width > room) label = label.slice(0, -2) + "\u2026";
+        g.fillStyle = "#1a1a1a"; g.fillText(label, a, y0 + rh / 2);
+      });
+    });
+    var x = edgeX(f + 0.5, w);
+    g.strokeStyle = "#c0262d"; g.lineWidth = 2;
+    g.beginPath(); g.moveTo(x, 0); g.lineTo(x, h); g.stroke();
+  }
+  // The spans shaded behind an error chart w × h: the first person with several prompts.
+  function shadeSpans(g, w, h) {
+    var row = tlRows.filter(function (r) { return r.spans.length > 1; })[0];
+    if (!row) return;
+    row.spans.forEach(function (s, i) {
+      var a = edgeX(s.from, w), b = edgeX(s.to, w);
+      g.globalAlpha = 0.08; g.fillStyle = SPAN_COLORS[i % SPAN_COLORS.length]; g.fillRect(a, 0, b - a, h);
+      g.globalAlpha = 0.6; g.fillRect(a, 0, 1, h);
+    });
+    g.globalAlpha = 1;
+  }
+
   // ---- statement error charts ----------------------------------------------------------------
   var charts = D.statement_errors.map(function (s) {
     var box = document.createElement("div"), head = document.createElement("div");
@@ -351,6 +434,7 @@
     var g = cv.getContext("2d");
     g.setTransform(dpr, 0, 0, dpr, 0, 0);
     g.clearRect(0, 0, w, h);
+    shadeSpans(g, w, h);
     var X = function (t) { return 6 + (N > 1 ? t / (N - 1) : 0.5) * (w - 12); };
     var Y = function (v) { return h - 5 - (v - c.vmin) / (c.vmax - c.vmin) * (h - 10); };
     if (c.vmin < 0) { g.strokeStyle = "#ddd"; g.lineWidth = 1; g.beginPath(); g.moveTo(0, Y(0)); g.lineTo(w, Y(0)); g.stroke(); }
@@ -493,6 +577,8 @@
     var active = D.contacts.filter(function (c) { return f >= c.frames[0] && f <= c.frames[1]; }).length;
     $("hud").textContent = active ? active + " contact" + (active > 1 ? "s" : "") + " active" : "";
     contactTags.forEach(function (t) { t.el.className = f >= t.c.frames[0] && f <= t.c.frames[1] ? "active" : ""; });
+    if (tlRows.length) { var pt = promptAt(f); $("prompt").textContent = pt; $("prompt").title = pt; }
+    drawTimeline(f);
     charts.forEach(function (c) { drawChart(c, f); });
     document.body.setAttribute("data-frame", String(f));
   }

@@ -1,6 +1,6 @@
-//! Header items and definitions: people, prompt, parameters (with `--set` overrides),
-//! length, user functions (duplicates, reserved names, recursion), and the library's
-//! functions and constants.
+//! Header items and definitions: people, prompt (timelines are `timeline.rs`'s),
+//! parameters (with `--set` overrides), length, user functions (duplicates, reserved
+//! names, recursion), and the library's functions and constants.
 
 use super::units::Unit;
 use super::values::{Cx, Val};
@@ -53,7 +53,14 @@ impl<'a> Checker<'a> {
                     seen_people = Some(*span);
                     self.declare_people(people, &cx);
                 }
-                Item::Prompt { text, span } => {
+                // The program's prompt for the whole motion; timeline prompts (with a
+                // span or a person) are read by `declare_timelines`.
+                Item::Prompt {
+                    person: None,
+                    range: None,
+                    text,
+                    span,
+                } => {
                     if let Some(first) = seen_prompt {
                         self.duplicate_header(&cx, "prompt", *span, first);
                     }
@@ -67,6 +74,7 @@ impl<'a> Checker<'a> {
             self.header.people.push(PersonInfo {
                 name: "me".into(),
                 prompt: self.header.prompt.clone(),
+                timeline: Vec::new(),
             });
         }
         self.multi = self.header.people.len() > 1;
@@ -92,9 +100,10 @@ impl<'a> Checker<'a> {
                 self.diags.push(d);
             }
         }
-        self.declare_length(module, &cx);
+        let length_ok = self.declare_length(module, &cx);
         self.declare_spacing(module, &cx);
         self.declare_starts(module, &cx);
+        self.declare_timelines(module, length_ok, &cx);
     }
 
     pub(super) fn duplicate_header(&mut self, cx: &Cx, what: &str, span: Span, first: Span) {
@@ -141,6 +150,7 @@ impl<'a> Checker<'a> {
             self.header.people.push(PersonInfo {
                 name: n.to_string(),
                 prompt: p.prompt.clone(),
+                timeline: Vec::new(),
             });
         }
     }
@@ -417,7 +427,9 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn declare_length(&mut self, module: &'a Module, cx: &Cx) {
+    /// Reads `length` into `header.length`; false when the line is wrong (the default
+    /// length stands in).
+    fn declare_length(&mut self, module: &'a Module, cx: &Cx) -> bool {
         let mut length = None;
         for item in &module.items {
             let Item::Length { value, span } = item else {
@@ -458,14 +470,9 @@ impl<'a> Checker<'a> {
                 length = Some((None, *span));
                 continue;
             }
-            if frames as usize > MODEL_MAX_FRAMES {
-                self.error(cx, crate::lang::codes::LONG_MOTION, value.span, format!("{frames} frames is longer than the model generates"))
-                    .label("longer than 9.8 s")
-                    .help(format!("the motion model makes at most {MODEL_MAX_FRAMES} frames (9.8 s); longer motions must be stitched"))
-                    .warning();
-            }
             length = Some((Some(frames as usize), *span));
         }
+        let ok = !matches!(length, Some((None, _)));
         self.header.length = match length {
             Some((Some(f), _)) => f,
             Some((None, _)) => MODEL_MAX_FRAMES,
@@ -481,6 +488,7 @@ impl<'a> Checker<'a> {
                 MODEL_MAX_FRAMES
             }
         };
+        ok
     }
 }
 

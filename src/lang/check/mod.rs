@@ -12,6 +12,7 @@
 //! | `calls.rs` | builtin and user function calls |
 //! | `numeric.rs` | numeric builtins: vector maths, `abs`/`sqrt`/`sin`…, `min`/`max`, `clamp`, `vec` |
 //! | `time.rs` | time positions (`2s`, `50%`, `end - 1`) |
+//! | `timeline.rs` | prompts and timelines (`prompt a 0s..8s "…"`): spans in frames, gaps, blends |
 //! | `builder.rs` | IR nodes: shapes, sharing, constant folding |
 //! | `advice.rs` | warnings on the IR: impossible, out-of-reach and jumping constraints |
 //! | `bounds.rs`, `feasibility.rs`, `reach.rs` | the interval analysis behind them |
@@ -31,6 +32,7 @@ pub mod reach;
 mod start;
 mod stmt;
 mod time;
+mod timeline;
 pub mod units;
 pub mod values;
 
@@ -41,6 +43,8 @@ use builder::Builder;
 use std::collections::HashMap;
 use units::Unit;
 use values::Cx;
+
+pub use timeline::TimedPrompt;
 
 /// Most tensor ops a program may need per evaluation.
 pub const MAX_OPS: usize = 20_000;
@@ -58,8 +62,12 @@ pub const MODEL_MAX_FRAMES: usize = 196;
 pub struct PersonInfo {
     /// Name (`me` in single-person programs).
     pub name: String,
-    /// Their prompt.
+    /// Their own prompt (`people a "…"`), or the first of their own timeline; `None` when
+    /// they take the program's (`me` copies the program's).
     pub prompt: Option<String>,
+    /// Their timeline at the declared length, in time order: one entry `0..length` for a
+    /// prompt without a span (their own or the program's), empty without any prompt.
+    pub timeline: Vec<TimedPrompt>,
 }
 
 /// A parameter after overrides.
@@ -85,7 +93,8 @@ pub struct ParamInfo {
 /// The header of a checked program.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Header {
-    /// The `prompt` line.
+    /// The program's prompt: its `prompt "…"` line, or the first prompt of its timeline
+    /// (`prompt 0s..8s "…"` lines naming no person).
     pub prompt: Option<String>,
     /// Length in frames.
     pub length: usize,

@@ -224,10 +224,34 @@ fn build_indices(ir: &Ir, frames: usize, device: &burn::tensor::Device) -> Cache
 
 /// Evaluates `ir` on joint positions `[batch, people, frames, 22, 3]`.
 pub fn evaluate(ir: &Ir, joints: Tensor<5>, cache: &IndexCache) -> Result<Evaluation, EvalError> {
+    let frames = joints.dims()[2];
+    evaluate_until(ir, joints, cache, frames)
+}
+
+/// [`evaluate`] counting only the frames before `until`: each statement's mean runs over
+/// the frames of its block that come before it, and a statement with none adds 0. A long
+/// motion is made window by window, and a window's error must not see the frames that are
+/// not made yet (they are placeholders). `until ≥ frames` is [`evaluate`].
+pub fn evaluate_until(
+    ir: &Ir,
+    joints: Tensor<5>,
+    cache: &IndexCache,
+    until: usize,
+) -> Result<Evaluation, EvalError> {
+    let frames = joints.dims()[2];
     with_node_values(ir, joints, cache, |values, idx, batch, device| {
         let mut columns = Vec::with_capacity(ir.statements.len());
         for s in &ir.statements {
-            columns.push(statement_error(ir, s, values, idx, batch, device));
+            let col = match frames_before(ir, s, values, frames, until) {
+                Before::All => statement_error(s, values, idx, batch, device),
+                Before::None => Tensor::<2>::zeros([batch, 1], device),
+                Before::Some(keep) => {
+                    let n = keep.len();
+                    let keep = Tensor::<4>::from_data(TensorData::new(keep, [1, n, 1, 1]), device);
+                    statement_error_masked(s, values, batch, Some(keep))
+                }
+            };
+            columns.push(col);
         }
         let per_statement = if columns.len() == 1 {
             columns.remove(0)
@@ -362,9 +386,47 @@ fn last_uses(ir: &Ir) -> Vec<usize> {
     last
 }
 
+/// Which of a statement's frames come before a frame limit.
+enum Before {
+    All,
+    None,
+    /// Per frame of the statement's block: 1 before the limit, 0 after.
+    Some(Vec<f32>),
+}
+
+fn frames_before(
+    ir: &Ir,
+    s: &Statement,
+    values: &[Option<Tensor<4>>],
+    frames: usize,
+    until: usize,
+) -> Before {
+    if until >= frames {
+        return Before::All;
+    }
+    let list = ir.resolve_domain(s.domain, frames);
+    let kept = list.iter().filter(|&&t| t < until).count();
+    let per_frame = values[s.error]
+        .as_ref()
+        .is_some_and(|e| e.dims()[1] == list.len() && list.len() > 1);
+    if kept == list.len() {
+        Before::All
+    } else if kept == 0 {
+        Before::None
+    } else if !per_frame {
+        // The same value on every frame: its mean over the kept frames is itself.
+        Before::All
+    } else {
+        Before::Some(
+            list.iter()
+                .map(|&t| if t < until { 1.0 } else { 0.0 })
+                .collect(),
+        )
+    }
+}
+
 /// weight × mean over the statement's frames (masked), summed over lanes → `[batch, 1]`.
 fn statement_error(
-    ir: &Ir,
     s: &Statement,
     values: &[Option<Tensor<4>>],
     idx: &CachedIndices,
@@ -393,7 +455,23 @@ fn statement_error(
             col.expand([batch, 1])
         };
     }
-    let (reduced, lanes) = match s.mask.and_then(|m| values[m].clone()) {
+    statement_error_masked(s, values, batch, None)
+}
+
+/// [`statement_error`] on its masked path, with `keep` (`[1, |D|, 1, 1]`, 0/1) multiplied
+/// into the statement's own `if` mask.
+fn statement_error_masked(
+    s: &Statement,
+    values: &[Option<Tensor<4>>],
+    batch: usize,
+    keep: Option<Tensor<4>>,
+) -> Tensor<2> {
+    let err = values[s.error].clone().expect("statement error is kept");
+    let mask = match (s.mask.and_then(|m| values[m].clone()), keep) {
+        (Some(m), Some(k)) => Some(m * k),
+        (m, k) => m.or(k),
+    };
+    let (reduced, lanes) = match mask {
         Some(mask) => {
             let lanes = err.dims()[2].max(mask.dims()[2]);
             // Σ_t e·m / max(Σ_t m, 1): mean over the frames where the condition holds.
@@ -420,7 +498,6 @@ fn statement_error(
     } else {
         col.mul_scalar(factor)
     };
-    let _ = ir;
     if b == batch {
         col
     } else {

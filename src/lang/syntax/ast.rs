@@ -43,8 +43,18 @@ pub struct Module {
 /// One top-level item.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum Item {
-    /// `prompt "…"`.
-    Prompt { text: String, span: Span },
+    /// `prompt "…"`, `prompt 0s..8s "…"` (a span of the timeline) or
+    /// `prompt a 0s..8s "…"` (a span of person `a`'s timeline).
+    Prompt {
+        /// The person it is for (`a`), if named.
+        person: Option<Ident>,
+        /// The time span `from..to`, if given.
+        range: Option<(Expr, Expr)>,
+        /// The prompt.
+        text: String,
+        /// The whole line.
+        span: Span,
+    },
     /// `length 6s`.
     Length { value: Expr, span: Span },
     /// `spacing 1 m`: metres between neighbouring people at the start.

@@ -129,7 +129,8 @@ fn rule_name(rule: &Rule) -> String {
         Rule::member => "`.`",
         Rule::at_time => "`@`",
         Rule::param_list => "parameter names",
-        Rule::person => "a person name",
+        Rule::person | Rule::prompt_who => "a person name",
+        Rule::prompt_span => "a time span (`0s..8s`)",
         Rule::start_place | Rule::start_at | Rule::start_facing | Rule::kw_facing => {
             "`at [x, 0, z]` or `facing [dx, 0, dz]`"
         }
@@ -223,6 +224,10 @@ fn syntax_hint(source: &str, at: usize) -> String {
         "logical operators are the words `and`, `or`, `not`".into()
     } else if rest.starts_with('{') && line.trim_start().starts_with("def") {
         "a function is `def name(a, b) = expr` or `def name(a, b) { … }`".into()
+    } else if line.trim_start().starts_with("prompt") {
+        "a prompt is `prompt \"text\"`, or one span of a timeline: `prompt 0s..8s \"text\"` \
+         (`prompt a 0s..8s \"text\"` for person `a`)"
+            .into()
     } else if line.trim_start().starts_with("at") || line.trim_start().starts_with("during") {
         "time blocks are `at 0, 50%, end { … }`, `at 2s { … }` or `during 1s..2s { … }`".into()
     } else {
@@ -248,8 +253,25 @@ impl Builder<'_> {
         let span = span_of(&pair);
         Some(match pair.as_rule() {
             Rule::prompt_decl => {
-                let text = unescape(pair.into_inner().next()?.into_inner().next()?.as_str());
-                Item::Prompt { text, span }
+                let (mut person, mut range, mut text) = (None, None, String::new());
+                for part in pair.into_inner() {
+                    match part.as_rule() {
+                        Rule::prompt_who => person = part.into_inner().next().map(ident),
+                        Rule::prompt_span => {
+                            let mut ends = part.into_inner();
+                            let from = self.expr(ends.next()?);
+                            range = Some((from, self.expr(ends.next()?)));
+                        }
+                        Rule::string => text = unescape(part.into_inner().next()?.as_str()),
+                        _ => {}
+                    }
+                }
+                Item::Prompt {
+                    person,
+                    range,
+                    text,
+                    span,
+                }
             }
             Rule::length_decl => Item::Length {
                 value: self.expr(pair.into_inner().next()?),
