@@ -293,6 +293,10 @@ struct WindowError<'a> {
     inner: &'a dyn MotionError,
     /// `[people, start, 22, 3]` world joints made so far (flat).
     before: Vec<f32>,
+    /// The same as a `[1, people, start, 22, 3]` tensor on the device last asked for: the
+    /// guide evaluates the error thousands of times a window, and the frames made so far
+    /// (up to 200 s of them) are the same every time.
+    before_tensor: std::sync::Mutex<Option<Tensor<5>>>,
     people: usize,
     start: usize,
     frames: usize,
@@ -304,13 +308,21 @@ impl WindowError<'_> {
         let device = window.device();
         let mut parts = Vec::with_capacity(3);
         if self.start > 0 {
-            let before = Tensor::<5>::from_data(
-                TensorData::new(
-                    self.before.clone(),
-                    [1, self.people, self.start, NUM_JOINTS, 3],
-                ),
-                &device,
-            );
+            let mut cached = self.before_tensor.lock().unwrap_or_else(|e| e.into_inner());
+            let before = match cached.as_ref().filter(|t| t.device() == device) {
+                Some(t) => t.clone(),
+                None => {
+                    let t = Tensor::<5>::from_data(
+                        TensorData::new(
+                            self.before.clone(),
+                            [1, self.people, self.start, NUM_JOINTS, 3],
+                        ),
+                        &device,
+                    );
+                    *cached = Some(t.clone());
+                    t
+                }
+            };
             parts.push(before.expand([b, p, self.start, NUM_JOINTS, 3]));
         }
         let end = self.start + n;
@@ -415,6 +427,7 @@ pub fn solve_long(
             let window_error = WindowError {
                 inner: error,
                 before,
+                before_tensor: Default::default(),
                 people,
                 start: win.start,
                 frames: req.frames,
