@@ -1,7 +1,7 @@
 """Checks an mprog BVH export with Blender's own BVH importer.
 
 Usage:
-    blender -b --factory-startup --python scripts/blender_check.py -- IN.bvh EXPECTED.npy [--zup] [--tol 0.01]
+    blender -b --factory-startup --python scripts/blender_check.py -- IN.bvh EXPECTED.npy [--zup] [--tol 0.01] [--names N0,…,N21] [--scale S]
 
 IN.bvh is a file written by mprog's BVH exporter; EXPECTED.npy holds the joint positions it
 was written from, float32 [frames, 22, 3], metres, Y up (mprog's convention). The script
@@ -11,6 +11,15 @@ Blender's Z-up axes and is imported with forward Y / up Z, i.e. unchanged), eval
 frame, reads the world-space head of the bones named after the 22 HumanML3D joints, and
 compares them with EXPECTED converted to Blender's axes. It prints one line
 "blender_check: OK|FAIL max error E m (frames F, joints 22)" and exits non-zero on failure.
+
+For a file written on a user's rig (`--rig`), --names gives the bones of the 22 joints in
+HumanML3D order (e.g. Hips,LeftUpLeg,RightUpLeg,Spine,LeftLeg,…,RightHand), --scale the
+importer's global scale (0.01 for a rig in centimetres), and EXPECTED.npy is what mprog's own
+reader makes of IN.bvh (`mprog convert IN.bvh -o EXPECTED.npy`): the check is then that
+Blender reads the file as mprog does. With --names it also prints one line
+"blender_check: feet median lowest L m, hips travel D m": the median over frames of the
+lowest of the ankles and toes, and the horizontal distance the hips travel (both in
+Blender's Z-up metres).
 
 Blender 3.4's importer opens files with mode 'rU', which Python 3.11 rejects; the builtin
 open is wrapped to drop the 'U' during the import.
@@ -63,10 +72,14 @@ def parse_args():
     tol = 0.01
     if "--tol" in argv:
         tol = float(argv[argv.index("--tol") + 1])
-    return argv[0], argv[1], "--zup" in argv, tol
+    names = argv[argv.index("--names") + 1].split(",") if "--names" in argv else None
+    if names is not None and len(names) != len(JOINT_NAMES):
+        raise ValueError(f"--names needs 22 names, got {len(names)}")
+    scale = float(argv[argv.index("--scale") + 1]) if "--scale" in argv else 1.0
+    return argv[0], argv[1], "--zup" in argv, tol, names, scale
 
 
-def import_bvh(path, zup):
+def import_bvh(path, zup, scale):
     real_open = builtins.open
 
     def open_without_u(file, mode="r", *args, **kwargs):
@@ -76,7 +89,7 @@ def import_bvh(path, zup):
     try:
         axes = {"axis_forward": "Y", "axis_up": "Z"} if zup else {"axis_forward": "-Z", "axis_up": "Y"}
         result = bpy.ops.import_anim.bvh(
-            filepath=path, target="ARMATURE", global_scale=1.0, frame_start=1,
+            filepath=path, target="ARMATURE", global_scale=scale, frame_start=1,
             use_fps_scale=False, update_scene_fps=True, update_scene_duration=True,
             rotate_mode="NATIVE", **axes)
     finally:
@@ -90,7 +103,9 @@ def import_bvh(path, zup):
 
 
 def main():
-    bvh_path, npy_path, zup, tol = parse_args()
+    bvh_path, npy_path, zup, tol, names, scale = parse_args()
+    report = names is not None
+    names = names or JOINT_NAMES
     # Start from an empty scene (the factory scene has a cube, camera and light).
     bpy.ops.wm.read_factory_settings(use_empty=True)
     (frames, joints, dims), flat = load_npy_f32(npy_path)
@@ -101,19 +116,25 @@ def main():
         # mprog Y up -> Blender Z up: (x, y, z) -> (x, -z, y), as either import path gives.
         x, y, z = flat[(f * joints + j) * 3:(f * joints + j) * 3 + 3]
         return Vector((x, -z, y))
-    arm = import_bvh(bvh_path, zup)
+    arm = import_bvh(bvh_path, zup, scale)
     scene = bpy.context.scene
-    missing = [n for n in JOINT_NAMES if n not in arm.pose.bones]
+    missing = [n for n in names if n not in arm.pose.bones]
     if missing:
         raise RuntimeError(f"bones missing from the import: {missing}")
     worst = 0.0
+    lows, hips = [], []
     for f in range(frames):
         scene.frame_set(1 + f)
         world = arm.matrix_world
-        for j, name in enumerate(JOINT_NAMES):
-            head = world @ arm.pose.bones[name].head
-            err = (head - want(f, j)).length
-            worst = max(worst, err)
+        heads = [world @ arm.pose.bones[name].head for name in names]
+        for j, head in enumerate(heads):
+            worst = max(worst, (head - want(f, j)).length)
+        lows.append(min(heads[j].z for j in (7, 8, 10, 11)))
+        hips.append(heads[0].copy())
+    if report:
+        lows.sort()
+        travel = sum(((b.x - a.x) ** 2 + (b.y - a.y) ** 2) ** 0.5 for a, b in zip(hips, hips[1:]))
+        print(f"blender_check: feet median lowest {lows[len(lows) // 2]:.4f} m, hips travel {travel:.3f} m")
     status = "OK" if worst < tol else "FAIL"
     print(f"blender_check: {status} max error {worst:.3e} m (frames {frames}, joints {joints}, "
           f"fps {scene.render.fps}/{scene.render.fps_base})")

@@ -1,17 +1,23 @@
 """Checks an mprog glTF export (.glb) with Blender's own glTF importer.
 
 Usage:
-    blender -b --factory-startup --python scripts/blender_gltf_check.py -- IN.glb EXPECTED.npy [--tol 0.01]
+    blender -b --factory-startup --python scripts/blender_gltf_check.py -- IN.glb EXPECTED.npy [--tol 0.01] [--names N0,N1,…,N21]
 
 IN.glb is a file written by mprog's glTF writer for one person; EXPECTED.npy holds the joint
 positions it was written from, float32 [frames, 22, 3], metres, Y up (mprog's convention,
 and glTF's). The script sets the scene to 20 fps, imports the file with Blender's glTF
 importer (which converts Y up to Blender's Z up: (x, y, z) -> (x, -z, y)), evaluates every
-frame from the start of the imported action, reads the world-space location of the objects
-named after the 22 HumanML3D joints (the importer makes each skin-less node an empty), and
-compares them with EXPECTED in Blender's axes. It prints one line
-"blender_gltf_check: OK|FAIL max error E m (frames F, joints 22)" and exits non-zero on
-failure.
+frame from the start of the imported action, reads the world-space position of the 22
+joints, and compares them with EXPECTED in Blender's axes. mprog's .glb is skinned, so the
+importer makes an armature (its pose bones' heads are the joints) with an action, and the
+body mesh deformed by it; a skin-less file (older mprog) gives one empty per node, which
+is read instead. --names gives the 22 node names in HumanML3D order for a file written
+with --rig (default: the HumanML3D names). It prints one line
+"blender_gltf_check: OK|FAIL max error E m (frames F, joints 22, armature yes|no)" and exits
+non-zero on failure, or when a skinned file does not import as an armature with an action.
+
+Blender 3.4's glTF importer reads meshes with `np.bool`, which NumPy 1.24 (Debian 12's)
+removed; the alias is put back before the import.
 """
 
 import array
@@ -20,7 +26,11 @@ import struct
 import sys
 
 import bpy
+import numpy
 from mathutils import Vector
+
+if "bool" not in numpy.__dict__:
+    numpy.bool = bool
 
 JOINT_NAMES = [
     "pelvis", "left_hip", "right_hip", "spine1", "left_knee", "right_knee", "spine2",
@@ -51,11 +61,14 @@ def parse_args():
         print(__doc__)
         sys.exit(2)
     tol = float(argv[argv.index("--tol") + 1]) if "--tol" in argv else 0.01
-    return argv[0], argv[1], tol
+    names = argv[argv.index("--names") + 1].split(",") if "--names" in argv else JOINT_NAMES
+    if len(names) != len(JOINT_NAMES):
+        raise ValueError(f"--names needs 22 names, got {len(names)}")
+    return argv[0], argv[1], tol, names
 
 
 def main():
-    glb_path, npy_path, tol = parse_args()
+    glb_path, npy_path, tol, names = parse_args()
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.fps, scene.render.fps_base = 20, 1.0
@@ -66,9 +79,26 @@ def main():
     if result != {"FINISHED"}:
         raise RuntimeError(f"glTF import failed: {result}")
     objects = {o.name: o for o in scene.objects}
-    missing = [n for n in JOINT_NAMES if n not in objects]
+    armatures = [o for o in scene.objects if o.type == "ARMATURE"]
+    if armatures:
+        arm = armatures[0]
+        missing = [n for n in names if n not in arm.pose.bones]
+        if not (arm.animation_data and arm.animation_data.action):
+            raise RuntimeError("the armature has no action")
+        meshes = [o for o in scene.objects if o.type == "MESH"
+                  and any(m.type == "ARMATURE" for m in o.modifiers)]
+        if not meshes:
+            raise RuntimeError("no mesh is deformed by the armature")
+
+        def joint_at(name):
+            return arm.matrix_world @ arm.pose.bones[name].head
+    else:
+        missing = [n for n in names if n not in objects]
+
+        def joint_at(name):
+            return objects[name].matrix_world.translation
     if missing:
-        raise RuntimeError(f"nodes missing from the import: {missing}")
+        raise RuntimeError(f"joints missing from the import: {missing}")
     actions = [o.animation_data.action for o in scene.objects
                if o.animation_data and o.animation_data.action]
     if not actions:
@@ -81,11 +111,11 @@ def main():
     worst = 0.0
     for f in range(frames):
         scene.frame_set(start + f)
-        for j, name in enumerate(JOINT_NAMES):
-            at = objects[name].matrix_world.translation
-            worst = max(worst, (at - want(f, j)).length)
+        for j, name in enumerate(names):
+            worst = max(worst, (joint_at(name) - want(f, j)).length)
     status = "OK" if worst < tol else "FAIL"
-    print(f"blender_gltf_check: {status} max error {worst:.3e} m (frames {frames}, joints {joints})")
+    print(f"blender_gltf_check: {status} max error {worst:.3e} m (frames {frames}, joints {joints}, "
+          f"armature {'yes' if armatures else 'no'})")
     sys.exit(0 if status == "OK" else 1)
 
 

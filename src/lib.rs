@@ -6,6 +6,7 @@
 #![doc = include_str!("../ARCHITECTURE.md")]
 
 pub mod backend;
+pub mod coverage;
 pub mod dataset;
 pub mod docgen;
 pub mod features;

@@ -189,3 +189,44 @@ fn long_requests_that_cannot_be_made_are_refused_before_any_work() {
     );
     assert!(!npy.exists(), "nothing written on failure");
 }
+
+#[test]
+fn a_timeline_alone_is_a_program() {
+    let dir = tempfile::tempdir().unwrap();
+    let prog = dir.path().join("t.mprog");
+    std::fs::write(
+        &prog,
+        "length 11s\n\
+         prompt 0s..6s \"a person walks forward\"\n\
+         prompt 6s..end \"a person waves the right hand\"\n",
+    )
+    .unwrap();
+    let out = run(&["check", prog.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json = dir.path().join("t.json");
+    let out = run(&[
+        "run",
+        prog.to_str().unwrap(),
+        "--no-baseline",
+        "--knob",
+        "steps=20",
+        "--knob",
+        "late_steps=4",
+        "--knob",
+        "k_late=30",
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (m, meta) = read_json(&json);
+    assert_eq!(m.len(), 220);
+    assert_eq!(meta["timeline"][0].as_array().unwrap().len(), 2);
+    // An empty program without a timeline is still refused.
+    std::fs::write(&prog, "prompt \"a person walks forward\"\n").unwrap();
+    let out = run(&["check", prog.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("empty_program")
+            || String::from_utf8_lossy(&out.stdout).contains("empty_program")
+    );
+}

@@ -417,3 +417,42 @@ fn a_bundle_with_a_controlnet_adds_guide_without_realism_to_the_task_table() {
         "{stderr}"
     );
 }
+
+/// A pose no training clip comes near is said before solving, on stderr as `check` says
+/// it, and kept in `meta.coverage` and the `--report` JSON (what the MCP `run` returns).
+#[test]
+fn runs_say_when_a_pose_is_not_in_the_training_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let prog = program(
+        dir.path(),
+        "prompt \"a person sits down on the floor\"\nlength 1s\nat 0.5s { pelvis.y < 20 cm\n head.y > 1.1 m }\n",
+    );
+    let json = dir.path().join("out.json");
+    let report = dir.path().join("report.json");
+    let out = run(&[
+        "run",
+        &prog,
+        "--no-baseline",
+        "--knob",
+        "steps=10",
+        "--report",
+        &report.display().to_string(),
+        "-o",
+        &json.display().to_string(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("no training pose comes near `pelvis.y < 20 cm` and `head.y > 1.1 m`"),
+        "{stderr}"
+    );
+    let saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let c = &saved["meta"]["coverage"];
+    assert_eq!(c["ok"], false, "{c}");
+    assert_eq!(c["unseen"][0]["code"], "mprog::unseen_pose", "{c}");
+    assert_eq!(c["unseen"][0]["line"], 3, "{c}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(&r["coverage"], c);
+}

@@ -1,8 +1,28 @@
 //! Diagnostic goldens: every `tests/diagnostics/*.mprog` is a wrong program whose first
 //! line names the codes it must produce (`# expect: mprog::unknown_joint, …`); the full
-//! plain-text report and the JSON form are pinned as insta snapshots.
+//! plain-text report and the JSON form are pinned as insta snapshots. The reports are what
+//! `mprog check` prints with the shipped model's pose coverage (`mprog::unseen_pose`;
+//! the prompt warnings need the sentence model and are left out).
 
-use mprog::lang::check_source;
+use mprog::coverage::Coverage;
+use mprog::lang::{Diagnostics, check_source, with_unseen_poses};
+use std::sync::OnceLock;
+
+/// The coverage set built into the binary (the shipped bundle's).
+fn coverage() -> &'static Coverage {
+    static SET: OnceLock<Coverage> = OnceLock::new();
+    SET.get_or_init(Coverage::builtin)
+}
+
+/// What `mprog check` reports for `src` (without the prompt warnings).
+fn check(src: &str, name: &str, overrides: &[(String, f64)]) -> Diagnostics {
+    with_unseen_poses(
+        check_source(src, name, overrides),
+        src,
+        overrides,
+        coverage(),
+    )
+}
 
 #[test]
 fn wrong_programs_report_expected_diagnostics() {
@@ -17,7 +37,7 @@ fn wrong_programs_report_expected_diagnostics() {
             .split(',')
             .map(str::trim)
             .collect();
-        let diags = check_source(&src, &name, &[]);
+        let diags = check(&src, &name, &[]);
         for code in &expected {
             assert!(
                 diags.items.iter().any(|d| d.code == *code),
@@ -30,6 +50,25 @@ fn wrong_programs_report_expected_diagnostics() {
         }
         insta::assert_snapshot!(diags.render_plain());
     });
+}
+
+#[test]
+fn poses_the_training_data_has_are_not_flagged() {
+    // The example, the pelvis under 0.2 m with the head above 0.65 m, is in the
+    // data (sitting up on the way down to lie on the floor), as are a squat and lying down.
+    for body in [
+        "during end - 0.5s..end + 1 { pelvis.y < 20 cm\n head.y > 65 cm }",
+        "during 2s..3s { pelvis.y < 50 cm\n head.y > 90 cm }",
+        "during end - 1s..end + 1 { pelvis.y < 25 cm\n head.y < 30 cm }",
+    ] {
+        let src = format!("length 6s\n{body}\n");
+        let d = check(&src, "x.mprog", &[]);
+        assert!(
+            !d.items.iter().any(|i| i.code == "mprog::unseen_pose"),
+            "{body}:\n{}",
+            d.render_plain()
+        );
+    }
 }
 
 #[test]

@@ -15,6 +15,7 @@ fn config(out: &std::path::Path) -> Config {
         time_limit: Duration::from_secs(5),
         card: None,
         far_prompts: None,
+        coverage: None,
     }
 }
 

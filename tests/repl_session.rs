@@ -423,3 +423,29 @@ fn run_edits_the_take_loaded_with_motion() {
     assert_eq!(meta["strength"], 0.5, "{meta}");
     assert_eq!(meta["keep_path"], true, "{meta}");
 }
+
+#[test]
+fn rig_puts_saved_motions_on_a_users_character() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/rigs/mixamo_tall.bvh"
+    );
+    let mut s = session();
+    assert!(say(&mut s, ":rig").contains("no rig"));
+    assert!(say(&mut s, &format!(":rig {rig}")).contains("65 joints"));
+    assert!(say(&mut s, ":rig").contains("mixamo_tall.bvh"));
+    let bvh = dir.path().join("on_rig.bvh");
+    say(&mut s, &format!(":save {}", bvh.display()));
+    let text = std::fs::read_to_string(&bvh).unwrap();
+    assert!(text.contains("JOINT LeftHandIndex1"), "the rig's joints");
+    say(&mut s, ":rig -");
+    say(&mut s, &format!(":save {}", bvh.display()));
+    assert!(
+        std::fs::read_to_string(&bvh)
+            .unwrap()
+            .contains("JOINT left_wrist")
+    );
+    let bad = fails(&mut s, ":rig nowhere.bvh");
+    assert!(bad.contains("nowhere.bvh"), "{bad}");
+}

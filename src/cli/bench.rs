@@ -26,6 +26,10 @@ pub enum BenchCommand {
     /// What the prior does with named actions: jump, kick, crouch, pick up, lie down, run,
     /// walk, turns, paraphrases, hand raises (seeds 1 and 2, one number each, ✗ below threshold).
     Actions(ActionBenchArgs),
+    /// The held-out paraphrase set: each caption and its other wordings generated with
+    /// each seed and judged; exact against paraphrase success, with `gen`'s
+    /// nearest-caption conditioning and literal (`bench/paraphrases.toml`).
+    Paraphrases(super::bench_paraphrases::ParaphraseBenchArgs),
 }
 
 /// Arguments of `mprog bench actions`.
@@ -93,6 +97,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Tasks(args) => super::bench_tasks::run(args),
         BenchCommand::Solvers(args) => super::bench_solvers::run(args),
         BenchCommand::Actions(args) => bench_actions(args),
+        BenchCommand::Paraphrases(args) => super::bench_paraphrases::run(args),
     }
 }
 

@@ -133,7 +133,7 @@ fn chosen_solvers(args: &TaskBenchArgs) -> Result<Vec<Solver>> {
 }
 
 /// UTC `YYYY-MM-DD HH:MM` of now (civil-from-days, proleptic Gregorian).
-fn utc_now() -> String {
+pub(super) fn utc_now() -> String {
     let secs = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs() as i64);

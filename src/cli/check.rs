@@ -60,11 +60,46 @@ pub fn prompt_report_of(text: PromptEncoder) -> Box<mprog::lang::PromptReport> {
     Box::new(move |prompt: &str| text.report(prompt))
 }
 
+/// The poses the model in `dir` was trained on (its `coverage.bin`, else the built-in
+/// set), for [`mprog::lang::with_unseen_poses`]; None, with a note on stderr, when the
+/// bundle's file is unreadable.
+pub fn coverage_of(dir: &std::path::Path) -> Option<mprog::coverage::Coverage> {
+    mprog::coverage::Coverage::for_bundle(dir)
+        .map_err(|e| eprintln!("note: no pose coverage, so no `mprog::unseen_pose` warnings: {e}"))
+        .ok()
+}
+
+/// Prints on stderr the `mprog::unseen_pose` warnings of `program` against the poses the
+/// model in `dir` was trained on (what `mprog check` would say), before a run solves;
+/// returns them for the outputs' meta and the run report:
+/// `{"source": …, "ok": bool, "unseen": [diagnostic, …]}` (null without a coverage set).
+pub fn print_unseen(program: &mprog::lang::Program, dir: &std::path::Path) -> serde_json::Value {
+    let Some(coverage) = coverage_of(dir) else {
+        return serde_json::Value::Null;
+    };
+    let found = mprog::lang::unseen_poses(program, &coverage);
+    let diags =
+        mprog::lang::Diagnostics::new(program.name(), program.warnings().source.clone(), found);
+    if !diags.items.is_empty() {
+        eprint!(
+            "{}",
+            diags.render_for(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        );
+    }
+    serde_json::json!({
+        "source": coverage.source,
+        "ok": diags.items.is_empty(),
+        "unseen": diags.to_json(),
+    })
+}
+
 /// Runs `mprog check`; returns whether every file is free of errors.
 pub fn run(args: &CheckArgs) -> miette::Result<bool> {
     let mut all_ok = true;
     let mut json = Vec::new();
-    let reader = sentence_reader(&mprog::model::weights::default_model_dir()).map(prompt_report_of);
+    let model_dir = mprog::model::weights::default_model_dir();
+    let reader = sentence_reader(&model_dir).map(prompt_report_of);
+    let coverage = coverage_of(&model_dir);
     for path in &args.files {
         let name = path.display().to_string();
         let source = std::fs::read_to_string(path)
@@ -72,6 +107,10 @@ pub fn run(args: &CheckArgs) -> miette::Result<bool> {
         let diags = mprog::lang::check_source(&source, &name, &args.set);
         let diags = match &reader {
             Some(report) => mprog::lang::with_far_prompts(diags, &source, report),
+            None => diags,
+        };
+        let diags = match &coverage {
+            Some(c) => mprog::lang::with_unseen_poses(diags, &source, &args.set, c),
             None => diags,
         };
         let ok = !diags.has_errors();

@@ -40,7 +40,8 @@ pub struct RenderArgs {
 }
 
 /// Runs `mprog convert`.
-pub fn convert(args: ConvertArgs) -> Result<()> {
+pub fn convert(mut args: ConvertArgs) -> Result<()> {
+    args.export.prepare(&args.out)?;
     let (people, meta) = load_input(&args.input, args.asf.as_deref())?;
     let title = args.input.display().to_string();
     write_outputs_with(&args.out, &people, &meta, &title, &args.export).map(|_| ())

@@ -15,6 +15,9 @@ pub enum DataCommand {
     /// Measure how a training set's clips move (per-joint speed and acceleration, floor,
     /// foot skating, rigid distances): the envelope plausibility reports check against.
     Envelope(EnvelopeArgs),
+    /// Keep the poses the training set holds (and how long each is held): what `check`
+    /// and `run` search when a program asks for a pose no clip comes near.
+    Coverage(super::coverage::CoverageArgs),
 }
 
 /// Arguments of `mprog data build`.
@@ -43,6 +46,7 @@ pub fn run(cmd: DataCommand) -> Result<()> {
         DataCommand::Build(args) => build(args),
         DataCommand::Show(args) => show(args),
         DataCommand::Envelope(args) => envelope(args),
+        DataCommand::Coverage(args) => super::coverage::run(args),
     }
 }
 

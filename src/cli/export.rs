@@ -1,11 +1,14 @@
 //! Export flags shared by every subcommand that writes motion files (`convert`, and `gen` /
-//! `run` through `#[command(flatten)]`): `--bvh-fps`, `--bvh-axes`, `--bvh-units`.
+//! `run` through `#[command(flatten)]`): `--bvh-fps`, `--bvh-axes`, `--bvh-units`, and the
+//! user's character, `--rig` / `--rig-map`.
 
-use miette::{Result, miette};
+use miette::{IntoDiagnostic, Result, miette};
+use mprog::formats::Character;
 use mprog::formats::bvh_export::{BvhAxes, BvhExportOptions, BvhUnits, MAX_EXPORT_FPS};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-/// How BVH outputs are written.
+/// How BVH (and glTF) outputs are written.
 #[derive(clap::Args, Clone, Debug, Default, PartialEq)]
 pub struct ExportArgs {
     /// Frame rate of BVH outputs, e.g. 30 or 60 for animation tools (joint positions are
@@ -19,6 +22,18 @@ pub struct ExportArgs {
     /// Length unit of BVH outputs: `m` or `cm` (most mocap files).
     #[arg(long, value_enum, value_name = "UNIT", default_value_t)]
     pub bvh_units: UnitsArg,
+    /// Put the motion on your character: a BVH of its skeleton (Mixamo, or any rig mprog
+    /// reads). .bvh and .glb outputs take the rig's joints, names, offsets, channels, units
+    /// and axes; joints mprog does not have (fingers, twist bones) keep their rest pose.
+    #[arg(long, value_name = "RIG.bvh")]
+    pub rig: Option<PathBuf>,
+    /// Which rig joint is which HumanML3D joint, for names mprog does not recognise: a TOML
+    /// file of lines such as `left_knee = "Knee_L"` (`mprog joints` lists the names).
+    #[arg(long, value_name = "MAP.toml", requires = "rig")]
+    pub rig_map: Option<PathBuf>,
+    /// The rig, once read ([`ExportArgs::prepare`]).
+    #[arg(skip)]
+    pub character: Option<Arc<Character>>,
 }
 
 /// `--bvh-axes` values.
@@ -71,19 +86,71 @@ impl ExportArgs {
         }
     }
 
-    /// Refuses BVH flags when no output is a `.bvh` file (they would silently do nothing).
+    /// Checks the flags against the outputs and reads the rig, printing how it was mapped:
+    /// called before any work, so a bad rig or flag does not cost a generation.
+    pub fn prepare(&mut self, outputs: &[PathBuf]) -> Result<()> {
+        self.check_against(outputs)?;
+        if self.character.is_none()
+            && let Some(rig) = &self.rig
+        {
+            let ch = load_rig(rig, self.rig_map.as_deref())?;
+            eprintln!("{}", ch.summary());
+            for note in &ch.notes {
+                eprintln!("  {note}");
+            }
+            self.character = Some(Arc::new(ch));
+        }
+        Ok(())
+    }
+
+    /// The rig, read by [`Self::prepare`] or now.
+    pub fn character(&self) -> Result<Option<Arc<Character>>> {
+        match (&self.character, &self.rig) {
+            (Some(ch), _) => Ok(Some(ch.clone())),
+            (None, Some(rig)) => Ok(Some(Arc::new(load_rig(rig, self.rig_map.as_deref())?))),
+            (None, None) => Ok(None),
+        }
+    }
+
+    /// Refuses BVH flags when no output is a `.bvh` file (they would silently do nothing),
+    /// `--rig` when no output is a `.bvh` or `.glb`, and units or axes with a rig (it keeps
+    /// its own).
     pub fn check_against(&self, outputs: &[PathBuf]) -> Result<()> {
-        let any_bvh = outputs
-            .iter()
-            .any(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")));
-        if *self != ExportArgs::default() && !any_bvh {
+        let has = |ext: &str| {
+            outputs
+                .iter()
+                .any(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext)))
+        };
+        let bvh_flags = self.bvh_fps.is_some()
+            || self.bvh_axes != AxesArg::default()
+            || self.bvh_units != UnitsArg::default();
+        if bvh_flags && !has("bvh") {
             return Err(miette!(
                 help = "add a .bvh output, or drop the --bvh-* flags",
                 "--bvh-fps / --bvh-axes / --bvh-units only affect .bvh outputs, and there is none"
             ));
         }
+        if self.rig.is_some() && !has("bvh") && !has("glb") {
+            return Err(miette!(
+                help = "add a .bvh or .glb output, or drop --rig",
+                "--rig only affects .bvh and .glb outputs, and there is none"
+            ));
+        }
+        if self.rig.is_some()
+            && (self.bvh_axes != AxesArg::default() || self.bvh_units != UnitsArg::default())
+        {
+            return Err(miette!(
+                help =
+                    "drop --bvh-axes / --bvh-units: the output keeps the rig's own units and axes",
+                "--bvh-axes and --bvh-units do not apply with --rig"
+            ));
+        }
         Ok(())
     }
+}
+
+fn load_rig(rig: &Path, map: Option<&Path>) -> Result<Character> {
+    Character::load(rig, map).into_diagnostic()
 }
 
 fn parse_fps(s: &str) -> std::result::Result<f32, String> {

@@ -192,10 +192,10 @@ fn generate_long(
 }
 
 /// Runs `mprog gen`.
-pub fn run(args: GenArgs) -> Result<()> {
+pub fn run(mut args: GenArgs) -> Result<()> {
     let started = Instant::now();
     check_outputs(&args.out)?;
-    args.export.check_against(&args.out)?;
+    args.export.prepare(&args.out)?;
     let device = super::device()?;
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let mut bundle = ModelBundle::load(&dir, &device)

@@ -49,11 +49,13 @@ pub fn write_outputs_with(
     export: &ExportArgs,
 ) -> Result<Vec<PathBuf>> {
     export.check_against(outputs)?;
+    let rig = export.character()?;
     let job = OutputJob {
         people,
         meta,
         title,
         bvh: &export.bvh_options(),
+        rig: rig.as_deref(),
     };
     let written = formats::write_outputs(outputs, &job).into_diagnostic()?;
     for path in &written {

@@ -42,6 +42,8 @@ pub fn run(args: McpArgs) -> Result<()> {
         // `check` warns on every prompt `run` would (sentence models).
         far_prompts: super::check::sentence_reader(&model_dir)
             .map(|text| std::sync::Arc::from(super::check::prompt_report_of(text))),
+        // ... and of every pose no training clip comes near.
+        coverage: super::check::coverage_of(&model_dir).map(std::sync::Arc::new),
     };
     mprog::mcp::serve_stdio(&config).map_err(|e| miette!("{e}"))
 }

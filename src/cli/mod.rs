@@ -1,10 +1,12 @@
 //! Subcommands of the `mprog` binary, one file each.
 
 pub mod bench;
+pub mod bench_paraphrases;
 pub mod bench_solvers;
 pub mod bench_tasks;
 pub mod check;
 pub mod convert;
+pub mod coverage;
 pub mod data;
 pub mod doc;
 pub mod eval;

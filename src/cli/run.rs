@@ -88,6 +88,13 @@ pub struct RunArgs {
     /// are written all the same, with the report in their meta.
     #[arg(long)]
     strict: bool,
+    /// Leave facing and posture to the program and the model: by default a person who
+    /// travels is steered to face along the path (unless the prompt asks for walking
+    /// backwards or sideways), and a person told to walk or run (and nothing low) is kept
+    /// from dipping the pelvis, since a program that pulls the pelvis round a path says
+    /// nothing of where the body faces or how upright it stays.
+    #[arg(long)]
+    free_facing: bool,
     /// Outputs; each one's extension picks its kind (`--help` lists them).
     #[arg(short, long, num_args = 1.., required = true, long_help = super::io::outputs_help())]
     out: Vec<PathBuf>,
@@ -152,6 +159,23 @@ fn timelines_of(program: &Program, prompts: &[String], frames: usize) -> Vec<Vec
         .collect()
 }
 
+/// Per person: whether the solver steers them to face along their path and keeps them
+/// upright ([`mprog::metrics::crouch::prompt_steering`]).
+fn facing_people(program: &Program, prompts: &[String], free: bool) -> Vec<(bool, bool)> {
+    let lines = program.timelines();
+    let texts: Vec<Vec<&str>> = prompts
+        .iter()
+        .enumerate()
+        .map(|(i, prompt)| {
+            let spans = lines.get(i).map(Vec::as_slice).unwrap_or(&[]);
+            std::iter::once(prompt.as_str())
+                .chain(spans.iter().map(|t| t.text.as_str()))
+                .collect()
+        })
+        .collect();
+    mprog::metrics::crouch::prompt_steering(&texts, free)
+}
+
 /// Solves `req` with a progress bar; with `timelines`, window by window
 /// ([`mprog::solve::long`]), the request giving the length, seed, solver and placements.
 fn solve_with_bar(
@@ -159,7 +183,7 @@ fn solve_with_bar(
     control: Option<&ControlNet>,
     req: &SolveRequest,
     timelines: Option<(&[Vec<PromptSpan>], usize, usize)>,
-    program: &Program,
+    error: &dyn mprog::solve::MotionError,
     device: &Device,
     label: &str,
 ) -> Result<SolveResult> {
@@ -170,7 +194,6 @@ fn solve_with_bar(
         ))
         .expect("template"),
     );
-    let error: &dyn mprog::solve::MotionError = program;
     let prior = Prior::from_bundle(bundle).with_control(control);
     let out = match timelines {
         None => solve(&prior, req, error, device, |p: Progress| {
@@ -228,12 +251,12 @@ pub fn solver_with_knobs(name: &str, knobs: &[(String, f64)]) -> Result<Solver> 
 }
 
 /// Runs `mprog run`.
-pub fn run(args: RunArgs) -> Result<()> {
+pub fn run(mut args: RunArgs) -> Result<()> {
     let program = compile_file(&args.program, &args.set)?;
     let solver = solver_with_knobs(&args.solver, &args.knobs)?;
     let prompts = prompts_of(&program, &args.text)?;
     check_outputs(&args.out)?;
-    args.export.check_against(&args.out)?;
+    args.export.prepare(&args.out)?;
     let device = super::device()?;
     let dir = args.model.clone().unwrap_or_else(default_model_dir);
     let mut bundle = ModelBundle::load(&dir, &device)
@@ -247,6 +270,8 @@ pub fn run(args: RunArgs) -> Result<()> {
         .into_diagnostic()?;
     let control_loaded = control.is_some();
     let envelope = super::plausible::envelope(&dir)?;
+    // Poses no training clip comes near, said before solving (as `check` says them).
+    let coverage = super::check::print_unseen(&program, &dir);
     let several = prompts.len() > 1;
     for (person, prompt) in program.people().iter().zip(&prompts) {
         for line in bundle.text.report(prompt) {
@@ -301,12 +326,21 @@ pub fn run(args: RunArgs) -> Result<()> {
         }
     };
     let req = request(solver.clone());
+    // The program's error, and what a walking prompt implies (`solve::facing`).
+    let steering = facing_people(&program, &prompts, args.free_facing);
+    let along = mprog::solve::facing::FacingAlongPath::new(
+        &program,
+        steering.iter().map(|s| s.0).collect(),
+        mprog::solve::facing::FACING_WEIGHT,
+        mprog::skeleton::FPS,
+    )
+    .upright(steering.iter().map(|s| s.1).collect());
     let result = solve_with_bar(
         &bundle,
         control.as_ref(),
         &req,
         windows,
-        &program,
+        &along,
         &device,
         solver.name(),
     )?;
@@ -321,7 +355,7 @@ pub fn run(args: RunArgs) -> Result<()> {
             control.as_ref(),
             &req,
             windows,
-            &program,
+            &along,
             &device,
             "unguided",
         )?;
@@ -449,6 +483,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     }
     meta.extend(mprog::view::program::program_meta(&program, people, &device).into_diagnostic()?);
     meta.insert("plausibility".into(), plausibility.to_json());
+    meta.insert("coverage".into(), coverage.clone());
     let written = write_outputs_with(
         &args.out,
         people,
@@ -481,6 +516,7 @@ pub fn run(args: RunArgs) -> Result<()> {
             "body": body_summary(people, &envelope),
             "plausibility": plausibility.to_json(),
             "plausibility_unguided": unguided_plausibility.as_ref().map(|u| u.to_json()),
+            "coverage": coverage,
             "outputs": written,
         });
         let text = serde_json::to_string_pretty(&report).into_diagnostic()?;

@@ -438,6 +438,10 @@ const RULES: &str = r#"
    ("ends lying down", "ends crouched") is held over the last half second,
    `during end - 0.5s..end + 1 { … }`: an `at end` block that fixes the posture on the
    last frame alone makes the body snap into it (`mprog::keyframe_pose`).
+   Ask for poses people are recorded in: `mprog::unseen_pose` warns when no training clip
+   comes near the pose a block asks for (the pelvis under 20 cm with the head above 1.1 m)
+   or holds it that long (standing on one leg with the other foot 30 cm up: 2 s at most),
+   and its hint names the nearest pose the data has; ask for that instead.
 7. Prefer tolerances to exact equalities for positions (`dist(p, q) < 5 cm`), and keep
    targets reachable: arms are about 0.6 m long, a step is about 0.7 m, walking speed is
    about 1.3 m/s. A hand target farther than that from where the person stands needs a

@@ -132,6 +132,7 @@ pub fn write_motion_with(
         meta,
         title: &title,
         bvh,
+        rig: None,
     };
     let bytes = (kind.encode)(&origin, &job).map_err(FormatError::Refused)?;
     crate::fsutil::write_bytes_atomic(path, &bytes)

@@ -25,6 +25,8 @@ pub struct OutputJob<'a> {
     pub title: &'a str,
     /// Units, axes and frame rate of BVH files.
     pub bvh: &'a BvhExportOptions,
+    /// The user's rig (`--rig`): BVH and glTF outputs take its skeleton.
+    pub rig: Option<&'a super::Character>,
 }
 
 /// A writer: the bytes of one file, or a message saying why the job cannot be written.
@@ -59,7 +61,7 @@ pub struct OutputKind {
 pub const OUTPUT_KINDS: &[OutputKind] = &[
     OutputKind {
         extensions: &["bvh"],
-        what: "a skeleton with rotations per joint (ZYX Euler angles), root translation, frame rate and axes in the header comments; for Blender, MotionBuilder, Maya",
+        what: "a skeleton with rotations per joint (ZYX Euler angles), root translation, frame rate and axes in the header comments; for Blender, MotionBuilder, Maya; with --rig, the rig's own joints, offsets, channels and units",
         file_per_person: true,
         sidecar: Sidecar::None,
         encode: writers::bvh,
@@ -80,7 +82,7 @@ pub const OUTPUT_KINDS: &[OutputKind] = &[
     },
     OutputKind {
         extensions: &["glb"],
-        what: "glTF 2.0 binary: each person a skeleton of joint nodes (rest offsets) animated by rotations and root translation; for three.js, game engines, Blender",
+        what: "glTF 2.0 binary: each person a skinned skeleton (joint nodes at their rest offsets, a skin with inverse bind matrices) with a simple body mesh, animated by rotations and root translation; for three.js, game engines, Blender; with --rig, the rig's skeleton",
         file_per_person: false,
         sidecar: Sidecar::None,
         encode: super::gltf::encode,
@@ -276,6 +278,7 @@ mod tests {
             meta: &meta,
             title: "two",
             bvh: &BvhExportOptions::default(),
+            rig: None,
         };
         let outs = [dir.path().join("a.npy"), dir.path().join("a.bvh")];
         let written = write_outputs(&outs, &job).unwrap();

@@ -381,6 +381,7 @@ fn pictures_draw_the_meta_timeline_and_refuse_a_broken_one() {
             meta: &meta,
             title: "t",
             bvh: &bvh,
+            rig: None,
         };
         (
             super::writers::png("t.png", &job),

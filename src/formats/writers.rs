@@ -12,10 +12,49 @@ pub fn bvh(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
             job.people.len()
         ));
     };
+    if let Some(rig) = job.rig {
+        return rig_bvh(origin, person, rig, job.bvh).map(String::into_bytes);
+    }
     // bvh_string refuses non-finite positions itself (naming frame and joint).
     super::bvh_export::bvh_string(person, job.bvh)
         .map(String::into_bytes)
         .map_err(|e| format!("{origin}: {e}"))
+}
+
+/// The BVH of `m` on the user's rig: at the export frame rate if one is set (positions
+/// resampled first, as [`super::bvh_export`] does), in the rig's own units and axes.
+fn rig_bvh(
+    origin: &str,
+    m: &Motion,
+    rig: &super::Character,
+    opts: &super::bvh_export::BvhExportOptions,
+) -> Result<String, String> {
+    use super::bvh_export::{BvhAxes, BvhUnits};
+    let fail = |kind| super::RigError::whole(origin, kind).to_string();
+    if opts.units != BvhUnits::default() || opts.axes != BvhAxes::default() {
+        return Err(fail(super::character::RigErrorKind::ExportOptions));
+    }
+    let resampled = export_rate(origin, m, opts)?;
+    let posed = rig
+        .retarget(resampled.as_ref().unwrap_or(m))
+        .map_err(|e| fail(super::character::RigErrorKind::Motion(e)))?;
+    Ok(super::character::write::bvh_text(rig, &posed))
+}
+
+/// `m` resampled to the BVH export rate, when one is set and differs from the motion's.
+pub fn export_rate(
+    origin: &str,
+    m: &Motion,
+    opts: &super::bvh_export::BvhExportOptions,
+) -> Result<Option<Motion>, String> {
+    use super::bvh_export::{BvhExportError, MAX_EXPORT_FPS, resample_cubic};
+    match opts.fps {
+        Some(fps) if !(fps.is_finite() && fps > 0.0 && fps <= MAX_EXPORT_FPS) => {
+            Err(format!("{origin}: {}", BvhExportError::BadFps(fps)))
+        }
+        Some(fps) if fps != m.fps => Ok(Some(resample_cubic(m, fps))),
+        _ => Ok(None),
+    }
 }
 
 /// `.npy`: float32 joint positions.

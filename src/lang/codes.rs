@@ -102,6 +102,9 @@ pub const UNKNOWN_NAME: &str = "mprog::unknown_name";
 pub const UNKNOWN_PARAM: &str = "mprog::unknown_param";
 /// A person the `people` line does not declare.
 pub const UNKNOWN_PERSON: &str = "mprog::unknown_person";
+/// A pose no training clip comes near, or one held longer than any clip holds it; the
+/// hint names the nearest pose the data has (warning; needs the model's coverage set).
+pub const UNSEEN_POSE: &str = "mprog::unseen_pose";
 
 /// Every code with what it means, for the book and its test.
 pub const ALL: &[(&str, &str)] = &[
@@ -232,5 +235,9 @@ pub const ALL: &[(&str, &str)] = &[
     (
         UNKNOWN_PERSON,
         "a person the `people` line does not declare",
+    ),
+    (
+        UNSEEN_POSE,
+        "a pose no training clip comes near (summed error over 0.15 m), or one held longer than any clip holds it; the hint names the nearest pose the data has (warning; needs the model's coverage set)",
     ),
 ];

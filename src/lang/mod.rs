@@ -7,7 +7,8 @@
 //! | evaluate | [`eval`] | [`eval::evaluate`] | [`Evaluation`] (burn tensors) |
 //!
 //! [`compile`] runs the first two stages and returns a [`Program`]; [`check_source`]
-//! returns every diagnostic (errors and warnings) for `mprog check`. The language itself
+//! returns every diagnostic (errors and warnings) for `mprog check`; [`with_unseen_poses`]
+//! adds the warnings that need the model's training data ([`unseen`]). The language itself
 //! is described in `book/src/reference/language.md` (the book) (syntax, semantics, the scale of the total error).
 
 pub mod check;
@@ -17,11 +18,13 @@ pub mod eval;
 pub mod ir;
 pub mod stdlib;
 pub mod syntax;
+pub mod unseen;
 
 pub use check::{Header, ParamInfo, PersonInfo, TimedPrompt};
 pub use diag::{Diagnostic, Diagnostics, Severity};
 pub use eval::{EvalError, Evaluation, FrameErrors, MAX_EVAL_ELEMENTS};
 pub use ir::CostEstimate;
+pub use unseen::{unseen_poses, with_unseen_poses};
 
 use burn::tensor::Tensor;
 use std::sync::Arc;

@@ -9,15 +9,20 @@ use serde_json::{Value, json};
 /// The name programs from a request are reported under.
 pub const SOURCE_NAME: &str = "program.mprog";
 
-/// `check`: what `mprog check --format json` prints for the program.
+/// `check`: what `mprog check --format json` prints for the program (with the model's
+/// far-prompt and unseen-pose warnings when the server was given what they need).
 pub fn check(
     source: &str,
     set: &[(String, f64)],
     far_prompts: Option<&crate::lang::PromptReport>,
+    coverage: Option<&crate::coverage::Coverage>,
 ) -> Value {
     let mut diags = crate::lang::check_source(source, SOURCE_NAME, set);
     if let Some(report) = far_prompts {
         diags = crate::lang::with_far_prompts(diags, source, report);
+    }
+    if let Some(c) = coverage {
+        diags = crate::lang::with_unseen_poses(diags, source, set, c);
     }
     json!({
         "file": SOURCE_NAME,
@@ -115,7 +120,7 @@ mod tests {
 
     #[test]
     fn check_reports_located_diagnostics() {
-        let v = check("length 4s\nalways { r_hnad.y > 1 m }\n", &[], None);
+        let v = check("length 4s\nalways { r_hnad.y > 1 m }\n", &[], None, None);
         assert_eq!(v["ok"], false);
         let d = &v["diagnostics"][0];
         assert_eq!(d["code"], crate::lang::codes::UNKNOWN_JOINT);
@@ -125,7 +130,7 @@ mod tests {
         );
         assert!(d["hint"].as_str().unwrap().contains("r_hand"));
         assert_eq!(
-            check("length 4s\nalways { head.y > 1 m }\n", &[], None)["ok"],
+            check("length 4s\nalways { head.y > 1 m }\n", &[], None, None)["ok"],
             true
         );
     }
@@ -140,6 +145,7 @@ mod tests {
             meta: &crate::motion::Meta::new(),
             title: "",
             bvh: &Default::default(),
+            rig: None,
         };
         crate::formats::write_outputs(&[out.root().join("m.json")], &job).unwrap();
         let src = "length 10 frames\nalways { head.y > 3 m }\n";
@@ -160,6 +166,24 @@ mod tests {
     }
 
     #[test]
+    fn check_warns_of_a_pose_no_training_clip_holds() {
+        let cov = crate::coverage::Coverage::builtin();
+        let src = "length 8s\nduring 1s..6s { l_foot.y > 30 cm\n r_foot.y < 5 cm }\n";
+        let v = check(src, &[], None, Some(&cov));
+        assert_eq!(v["ok"], true, "a warning, not an error");
+        let d = &v["diagnostics"][0];
+        assert_eq!(d["code"], crate::lang::codes::UNSEEN_POSE);
+        assert!(
+            d["hint"]
+                .as_str()
+                .unwrap()
+                .contains("the longest the training data holds it")
+        );
+        let without = check(src, &[], None, None);
+        assert!(without["diagnostics"].as_array().unwrap().is_empty());
+    }
+
+    #[test]
     fn check_warns_on_a_prompt_far_from_the_models_captions() {
         // What the model says of a prompt: the lines `run` would print before generating.
         let report = |prompt: &str| -> Vec<String> {
@@ -173,6 +197,7 @@ mod tests {
             "prompt \"a person plays the violin\"\nlength 2s\nat end { head.y > 1 m }\n",
             &[],
             Some(&report),
+            None,
         );
         let d = &far["diagnostics"][0];
         assert_eq!(d["code"], crate::lang::codes::FAR_PROMPT);
@@ -188,6 +213,7 @@ mod tests {
             "prompt \"a person walks\"\nlength 2s\nat end { head.y > 1 m }\n",
             &[],
             Some(&report),
+            None,
         );
         let far_prompts = near["diagnostics"]
             .as_array()

@@ -43,6 +43,9 @@ pub struct Config {
     /// What the model says of a prompt, for `check`'s `mprog::far_prompt` warnings (a
     /// sentence-encoder model's; the CLI passes it).
     pub far_prompts: Option<Arc<crate::lang::PromptReport>>,
+    /// The poses the model was trained on, for `check`'s `mprog::unseen_pose` warnings
+    /// (the CLI passes the bundle's; `run` results carry the run's own).
+    pub coverage: Option<Arc<crate::coverage::Coverage>>,
 }
 
 impl std::fmt::Debug for Config {
@@ -54,6 +57,7 @@ impl std::fmt::Debug for Config {
             .field("time_limit", &self.time_limit)
             .field("card", &self.card.as_ref().map(String::len))
             .field("far_prompts", &self.far_prompts.is_some())
+            .field("coverage", &self.coverage.is_some())
             .finish()
     }
 }
@@ -74,6 +78,7 @@ pub fn server(config: &Config) -> std::io::Result<server::Server> {
                 .unwrap_or_else(crate::docgen::prompt::system_prompt),
         ),
         far_prompts: config.far_prompts.clone(),
+        coverage: config.coverage.clone(),
     })
 }
 
@@ -176,6 +181,7 @@ pub fn fuzz_one(data: &[u8]) -> Result<(), String> {
         time_limit: Duration::from_secs(2),
         card: None,
         far_prompts: None,
+        coverage: None,
     })
     .map_err(|e| e.to_string())?;
     let mut input = HANDSHAKE.as_bytes().to_vec();

@@ -29,6 +29,8 @@ pub struct Server {
     pub(super) card: Arc<String>,
     /// Far-prompt warnings for `check` (see [`super::Config::far_prompts`]).
     pub(super) far_prompts: Option<Arc<crate::lang::PromptReport>>,
+    /// Unseen-pose warnings for `check` (see [`super::Config::coverage`]).
+    pub(super) coverage: Option<Arc<crate::coverage::Coverage>>,
 }
 
 fn text_result(v: &Value, error: bool) -> CallToolResult {
@@ -57,7 +59,8 @@ impl Server {
                 let source = args::source(&a).map_err(bad)?;
                 let set = args::settings(&a, "set").map_err(bad)?;
                 let far = self.far_prompts.as_deref();
-                text_result(&calls::check(&source, &set, far), false)
+                let cov = self.coverage.as_deref();
+                text_result(&calls::check(&source, &set, far, cov), false)
             }
             "score" => {
                 let source = args::source(&a).map_err(bad)?;

@@ -31,7 +31,9 @@ pub fn tools() -> Vec<Tool> {
             "check",
             "Parse and type-check an mprog program. Returns {ok, diagnostics}: each with code, \
              severity, message, hint, line, column (1-based) and the source snippet: the same \
-             as `mprog check --format json`. Warnings flag constraints no motion can meet.",
+             as `mprog check --format json`. Warnings flag constraints no motion can meet, and \
+             poses no training clip comes near or holds that long (`mprog::unseen_pose`: its \
+             hint names the nearest pose the data has; ask for that instead).",
             schema(json!({"type": "object", "required": ["source"],
                 "properties": {"source": source_property(), "set": set_property()}})),
         ),
@@ -50,7 +52,9 @@ pub fn tools() -> Vec<Tool> {
              \"met by a snap at 5.85–5.95 s\", \"not met\"), the plausibility report \
              (`plausibility`: ok, and each problem with its person, kind, body part, frames, \
              seconds, value, limit, what the limit is measured against and the statements \
-             active there: repair those), the files written (relative to the output folder) \
+             active there: repair those), the poses no training clip comes near \
+             (`coverage`: ok, and each `mprog::unseen_pose` warning, said before solving), \
+             the files written (relative to the output folder) \
              and a PNG strip of the motion. Runs are one at a time and stopped at the \
              server's time limit; for a quick look pass knobs such as {\"steps\": 10}.",
             schema(json!({"type": "object", "required": ["source"],

@@ -3,6 +3,7 @@
 //!
 //! | part | module | what |
 //! | --- | --- | --- |
+//! | actions and paraphrases | [`actions`], [`paraphrases`] | named actions measured on generated motions (`bench actions`); the held-out paraphrase set, exact caption against other wordings (`bench paraphrases`) |
 //! | per-motion metrics | [`per_motion`] | foot skating, max acceleration, bone-length variation, floor penetration, speed, turn, wrists above head |
 //! | plausibility | [`plausibility`] | every output held against an envelope measured on real clips: snaps, speed, floor, skating, people overlapping, rigid parts, facing; located in time |
 //! | linear algebra | [`linalg`] | Jacobi eigen-decomposition, PSD square root (f64) |
@@ -13,10 +14,12 @@
 
 pub mod actions;
 pub mod card;
+pub mod crouch;
 pub mod encoder;
 pub mod error;
 pub mod evaluator;
 pub mod linalg;
+pub mod paraphrases;
 pub mod per_motion;
 pub mod plausibility;
 pub mod report;

@@ -11,6 +11,7 @@
 //! | `interpenetration` | two people's body capsules ([`CAPSULES`]) overlap by more than [`OVERLAP_DEPTH`] | fixed radii |
 //! | `rigid_deformation` | a distance no bone holds (hip width, shoulder width, the spine) leaves the real range widened by [`RIGID_SLACK`] | the envelope's `rigid` |
 //! | `facing` | moving faster than [`FACING_SPEED`] backwards or sideways for [`FACING_FRAMES`] frames, when the prompt does not ask for it | fixed angles |
+//! | `crouch` | the pelvis more than [`CROUCH_DROP`](super::crouch::CROUCH_DROP) below its median height for 3 frames, when the prompt asks for walking or running and nothing low ([`super::crouch`]) | real walks and runs (0.11 m on 99 % of clips) |
 //! | `invalid` | a coordinate is not a finite number | — |
 //!
 //! Consecutive bad frames (gaps up to [`GAP`] frames) form one [`Problem`]. The report
@@ -80,6 +81,23 @@ pub const FACING_EXEMPT: &[&str] = &[
     "crab",
     "grapevine",
     "lateral",
+];
+
+pub use super::crouch::{crouch_check, prompt_forbids_crouch};
+
+/// Phrases before "to the left/right" that name a bend of the path.
+const TURN_PHRASES: &[&str] = &[
+    "circle to the",
+    "circles to the",
+    "turn to the",
+    "turns to the",
+    "turning to the",
+    "curve to the",
+    "curves to the",
+    "veer to the",
+    "veers to the",
+    "bend to the",
+    "bends to the",
 ];
 
 /// A body capsule: a segment between two joints with a radius (m).
@@ -156,6 +174,8 @@ pub enum Kind {
     RigidDeformation,
     /// Walking backwards or sideways.
     Facing,
+    /// The pelvis sinks far below its walking height in a walk or run.
+    Crouch,
     /// Coordinates that are not numbers.
     Invalid,
 }
@@ -171,6 +191,7 @@ impl Kind {
             Kind::Interpenetration => "people overlapping",
             Kind::RigidDeformation => "a deformed body",
             Kind::Facing => "walking against the facing",
+            Kind::Crouch => "a crouch the prompt does not ask for",
             Kind::Invalid => "invalid coordinates",
         }
     }
@@ -185,6 +206,7 @@ impl Kind {
             Kind::Interpenetration => "interpenetration",
             Kind::RigidDeformation => "rigid part deformed",
             Kind::Facing => "facing against the path",
+            Kind::Crouch => "crouch",
             Kind::Invalid => "invalid",
         }
     }
@@ -384,7 +406,12 @@ impl Report {
 
 /// Whether a prompt asks for walking backwards or sideways.
 pub fn prompt_allows_facing(prompt: &str) -> bool {
-    let p = prompt.to_lowercase();
+    let mut p = prompt.to_lowercase();
+    // "walks in a circle to the right" and "turns to the left" say where the path bends,
+    // not that the body steps sideways.
+    for bend in TURN_PHRASES {
+        p = p.replace(bend, " ");
+    }
     FACING_EXEMPT.iter().any(|w| p.contains(w))
 }
 
@@ -433,6 +460,9 @@ pub fn check(people: &[Motion], prompts: &[Option<String>], env: &Envelope) -> R
         rigid_checks(m, env, &mut found);
         if !prompt.is_some_and(prompt_allows_facing) {
             facing_check(m, &mut found);
+        }
+        if prompt.is_some_and(prompt_forbids_crouch) {
+            crouch_check(m, &mut found);
         }
         for p in &mut found {
             p.person = person;
@@ -1156,6 +1186,19 @@ mod tests {
         // The report serialises (NaN as null) for meta.
         let v = r.to_json();
         assert_eq!(v["ok"], false);
+    }
+
+    #[test]
+    fn a_bend_of_the_path_is_not_a_side_step() {
+        assert!(prompt_allows_facing("a person walks to the left"));
+        assert!(prompt_allows_facing("someone walks backwards"));
+        assert!(!prompt_allows_facing(
+            "a person walks in a circle to the right"
+        ));
+        assert!(!prompt_allows_facing(
+            "a person walks and turns to the left"
+        ));
+        assert!(!prompt_allows_facing("a person walks forward"));
     }
 
     #[test]

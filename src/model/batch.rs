@@ -6,6 +6,7 @@ use super::config::TrainConfig;
 use super::schedule::DIFFUSION_STEPS;
 use super::text::{is_function_word, words_of};
 use crate::dataset::{ClipInfo, Dataset, FEATURE_DIM};
+use crate::features::layout::{LOCAL_VEL, ROOT_VEL, ROOT_YAW_VEL};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -29,6 +30,21 @@ pub struct HostBatch {
     pub keep_text: Vec<f32>,
     /// Generator state after drawing the batch (used for the noise).
     pub noise_seed: u64,
+    /// Per-dimension noise added to the sentence vectors (`TrainConfig::text_noise`).
+    pub text_noise: f64,
+}
+
+/// Feature columns that are motion to the next frame (zero while a pose is held).
+const MOVING: [std::ops::Range<usize>; 3] = [ROOT_YAW_VEL, ROOT_VEL, LOCAL_VEL];
+
+/// One sample of a batch: `len` frames of `clip` from `start`, placed at `before` in a
+/// window of `total` frames (`before = 0, total = len` unless hold-padded).
+struct Pick<'a> {
+    clip: &'a ClipInfo,
+    start: usize,
+    len: usize,
+    before: usize,
+    total: usize,
 }
 
 /// Generator for step `step` of a run seeded with `seed`.
@@ -77,7 +93,7 @@ pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: us
             })
             .collect()
     });
-    let picks: Vec<(&ClipInfo, usize, usize)> = (0..cfg.batch_size)
+    let picks: Vec<Pick> = (0..cfg.batch_size)
         .map(|_| {
             let index = match &cumulative {
                 None => rng.random_range(0..clips.len()),
@@ -89,20 +105,42 @@ pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: us
             let clip = clips[index];
             let len = clip.frames.min(cfg.crop_frames);
             let start = rng.random_range(0..=clip.frames - len);
-            (clip, start, len)
+            let (before, total) = if cfg.hold_pad > 0.0
+                && clip.frames < cfg.crop_frames
+                && rng.random::<f64>() < cfg.hold_pad
+            {
+                let total = rng.random_range(len..=(2 * len).min(cfg.crop_frames));
+                (rng.random_range(0..=total - len), total)
+            } else {
+                (0, len)
+            };
+            Pick {
+                clip,
+                start,
+                len,
+                before,
+                total,
+            }
         })
         .collect();
-    let frames = picks.iter().map(|p| p.2).max().unwrap_or(1);
+    let frames = picks.iter().map(|p| p.total).max().unwrap_or(1);
     let b = picks.len();
     let mut x0 = vec![0.0f32; b * frames * FEATURE_DIM];
     let mut padding = vec![true; b * frames];
     let mut captions = Vec::with_capacity(b);
-    for (i, (clip, start, len)) in picks.iter().enumerate() {
-        let rows = &ds.clip_features(clip)[start * FEATURE_DIM..(start + len) * FEATURE_DIM];
-        for (k, row) in rows.chunks_exact(FEATURE_DIM).enumerate() {
+    for (i, pick) in picks.iter().enumerate() {
+        let clip = pick.clip;
+        let features = ds.clip_features(clip);
+        for k in 0..pick.total {
+            // Held frames repeat the clip's first or last pose, standing still.
+            let inside = k.clamp(pick.before, pick.before + pick.len - 1) - pick.before;
+            let held = k != inside + pick.before;
+            let row = &features[(pick.start + inside) * FEATURE_DIM..][..FEATURE_DIM];
             let dst = &mut x0[(i * frames + k) * FEATURE_DIM..][..FEATURE_DIM];
             for f in 0..FEATURE_DIM {
-                dst[f] = (row[f] - ds.mean[f]) / ds.std[f];
+                let still = held && MOVING.iter().any(|r| r.contains(&f));
+                let v = if still { 0.0 } else { row[f] };
+                dst[f] = (v - ds.mean[f]) / ds.std[f];
             }
             padding[i * frames + k] = false;
         }
@@ -137,6 +175,7 @@ pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: us
         timesteps,
         keep_text,
         noise_seed: rng.random(),
+        text_noise: cfg.text_noise,
     }
 }
 

@@ -194,8 +194,54 @@ pub struct TrainConfig {
     /// Largest weight of [`Self::low_noise_below`].
     #[serde(default, skip_serializing_if = "is_zero")]
     pub low_noise_loss_cap: f64,
+    /// Probability of training a sample on a rule-made paraphrase of its caption instead
+    /// of the caption (sentence-encoder runs; `train::augment`): a paraphrase the model
+    /// never saw drifted away from what its caption does.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub paraphrase_prob: f64,
+    /// Least cosine between a paraphrase and its caption for the paraphrase to be kept.
+    #[serde(
+        default = "default_paraphrase_min_cos",
+        skip_serializing_if = "is_default_min_cos"
+    )]
+    pub paraphrase_min_cos: f64,
+    /// Most paraphrases kept per caption.
+    #[serde(
+        default = "default_paraphrases_per_caption",
+        skip_serializing_if = "is_default_per_caption"
+    )]
+    pub paraphrases_per_caption: usize,
+    /// A TOML file whose strings are wordings never trained on (the held-out paraphrase
+    /// set the run is measured on).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paraphrase_holdout: Option<String>,
+    /// Gaussian noise per dimension added to each sentence vector (then renormalised), so
+    /// the model answers a neighbourhood of each caption, not its point.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub text_noise: f64,
+    /// Probability that a clip shorter than `crop_frames` is placed inside a longer
+    /// window (up to twice its length) with its first pose held before it and its last
+    /// after: an action learnt only at its clip's length did not happen in a longer motion.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub hold_pad: f64,
     /// Seed of the data order and noise.
     pub seed: u64,
+}
+
+fn default_paraphrase_min_cos() -> f64 {
+    0.8
+}
+
+fn default_paraphrases_per_caption() -> usize {
+    16
+}
+
+fn is_default_min_cos(v: &f64) -> bool {
+    *v == default_paraphrase_min_cos()
+}
+
+fn is_default_per_caption(v: &usize) -> bool {
+    *v == default_paraphrases_per_caption()
 }
 
 impl Default for TrainConfig {
@@ -223,6 +269,12 @@ impl Default for TrainConfig {
             high_noise_fraction: 0.0,
             low_noise_below: 0,
             low_noise_loss_cap: 0.0,
+            paraphrase_prob: 0.0,
+            paraphrase_min_cos: default_paraphrase_min_cos(),
+            paraphrases_per_caption: default_paraphrases_per_caption(),
+            paraphrase_holdout: None,
+            text_noise: 0.0,
+            hold_pad: 0.0,
             seed: 1,
         }
     }
@@ -334,6 +386,28 @@ impl TrainConfig {
         fraction("cond_drop", self.cond_drop, false)?;
         fraction("word_drop", self.word_drop, false)?;
         fraction("high_noise_fraction", self.high_noise_fraction, false)?;
+        fraction("paraphrase_prob", self.paraphrase_prob, false)?;
+        fraction("paraphrase_min_cos", self.paraphrase_min_cos, false)?;
+        fraction("hold_pad", self.hold_pad, false)?;
+        in_range(
+            "paraphrases_per_caption",
+            self.paraphrases_per_caption,
+            1,
+            1000,
+        )?;
+        if !(self.text_noise.is_finite() && (0.0..=1.0).contains(&self.text_noise)) {
+            return Err(format!(
+                "`text_noise` is {}; it must be in [0, 1]",
+                self.text_noise
+            ));
+        }
+        if (self.paraphrase_prob > 0.0 || self.text_noise > 0.0)
+            && self.model.text_encoder != TextEncoderKind::Sentence
+        {
+            return Err(
+                "`paraphrase_prob` and `text_noise` need `text_encoder = \"minilm\"`".into(),
+            );
+        }
         in_range(
             "low_noise_below",
             self.low_noise_below,

@@ -262,3 +262,57 @@ fn a_sentence_bundle_starts_a_run_with_the_side_input() {
     assert_eq!(names["side_proj.weight"].len(), 384 * tiny().d_model);
     assert!(!names.contains_key("side_proj.bias"));
 }
+
+#[test]
+fn an_augmented_run_keeps_near_paraphrases_and_never_a_held_out_one() {
+    use super::train::augment::{CaptionAugment, normalise};
+    use super::train::paraphrase::paraphrases;
+    let data = synthetic_dataset();
+    let out = tempfile::tempdir().unwrap();
+    // Hold out the first rule-made wording of the walk: it must never be trained on.
+    let held = paraphrases("a person walks forward")[0].clone();
+    let holdout = out.path().join("held.toml");
+    std::fs::write(&holdout, format!("wordings = [\"{held}\"]\n")).unwrap();
+    let config = TrainConfig {
+        model: sentence_tiny(),
+        batch_size: 2,
+        crop_frames: 8,
+        learning_rate: 1e-3,
+        warmup_steps: 1,
+        checkpoint_every: 3,
+        steps: 100,
+        paraphrase_prob: 0.5,
+        paraphrases_per_caption: 4,
+        paraphrase_holdout: Some(holdout.display().to_string()),
+        text_noise: 0.02,
+        hold_pad: 0.5,
+        ..TrainConfig::default()
+    };
+    let run = |steps| {
+        TrainRun {
+            data: &data,
+            config: config.clone(),
+            out: out.path().to_path_buf(),
+            max_steps_now: Some(steps),
+            interrupt: Default::default(),
+            init_from: None,
+            device: Device::flex(),
+            after_checkpoint: None,
+            text_encoder: None,
+        }
+        .run(&|_, _, _| {})
+        .unwrap()
+    };
+    assert_eq!(run(3).step, 3);
+    let table = CaptionAugment::load_table(&out.path().join("paraphrases.json")).unwrap();
+    let walks = &table["a person walks forward"];
+    assert!(!walks.is_empty() && walks.len() <= 4, "{walks:?}");
+    assert!(
+        walks.iter().all(|w| normalise(w) != normalise(&held)),
+        "{walks:?}"
+    );
+    // Resuming reads the table back instead of drawing it again.
+    assert_eq!(run(3).step, 6);
+    let again = CaptionAugment::load_table(&out.path().join("paraphrases.json")).unwrap();
+    assert_eq!(table, again);
+}

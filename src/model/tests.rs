@@ -454,3 +454,62 @@ fn a_high_noise_share_draws_late_timesteps_and_none_keeps_the_old_draw() {
         .collect();
     assert_eq!(batch.timesteps, want);
 }
+
+#[test]
+fn hold_padding_places_a_short_clip_inside_a_still_window() {
+    use crate::features::layout::{LOCAL_VEL, RIC, ROOT_VEL, ROOT_YAW_VEL};
+    use crate::model::batch::draw_batch;
+    let ds = synthetic_dataset();
+    let train: Vec<&ClipInfo> = ds.clips(Split::Train).collect();
+    let cfg = TrainConfig {
+        batch_size: 8,
+        crop_frames: 40,
+        hold_pad: 1.0,
+        ..TrainConfig::default()
+    };
+    let clip = &ds.features[..24 * FEATURE_DIM];
+    let mut padded = 0;
+    for step in 0..6 {
+        let b = draw_batch(&ds, &train, &cfg, step);
+        assert!(b.frames <= 40 && b.frames >= 24);
+        for i in 0..8 {
+            let rows: Vec<&[f32]> = (0..b.frames)
+                .filter(|&k| !b.padding[i * b.frames + k])
+                .map(|k| &b.x0[(i * b.frames + k) * FEATURE_DIM..][..FEATURE_DIM])
+                .collect();
+            assert!((24..=40).contains(&rows.len()), "{}", rows.len());
+            // The clip appears whole and in order; every other row holds its first or
+            // last pose, still.
+            let at = (0..=rows.len() - 24)
+                .find(|&a| rows[a] == &clip[..FEATURE_DIM])
+                .expect("the clip's first frame");
+            for k in 0..24 {
+                assert_eq!(rows[at + k], &clip[k * FEATURE_DIM..][..FEATURE_DIM]);
+            }
+            for (k, row) in rows.iter().enumerate() {
+                if (at..at + 24).contains(&k) {
+                    continue;
+                }
+                padded += 1;
+                let src = if k < at { 0 } else { 23 };
+                let pose = &clip[src * FEATURE_DIM..][..FEATURE_DIM];
+                assert_eq!(row[RIC], pose[RIC]);
+                for r in [ROOT_YAW_VEL, ROOT_VEL, LOCAL_VEL] {
+                    assert!(row[r].iter().all(|&v| v == 0.0));
+                }
+            }
+        }
+    }
+    assert!(padded > 0, "no sample was padded");
+    // Without hold_pad the clip is its own length.
+    let plain = draw_batch(
+        &ds,
+        &train,
+        &TrainConfig {
+            hold_pad: 0.0,
+            ..cfg
+        },
+        0,
+    );
+    assert_eq!(plain.frames, 24);
+}

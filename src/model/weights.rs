@@ -10,6 +10,9 @@
 //! <dir>/lengths.json       median clip length per training caption (optional)
 //! <dir>/envelope.json      how the training clips move, for plausibility reports
 //!                          (optional; `mprog data envelope` measures it)
+//! <dir>/coverage.bin       the poses the training clips hold, for `mprog::unseen_pose`
+//!                          (optional; `mprog data coverage` builds it, and
+//!                          `mprog::coverage::Coverage::for_bundle` reads it)
 //! <dir>/mean.npy, std.npy  [263] normalisation statistics
 //! <dir>/model.safetensors  denoiser weights
 //! ```

@@ -43,6 +43,9 @@ pub enum Command {
     /// `:save FILE`: the program (`.mprog`) or the current motion, as any kind of the
     /// output table ([`crate::formats::outputs::OUTPUT_KINDS`]).
     Save(PathBuf),
+    /// `:rig [RIG.bvh | -]`: save `.bvh` / `.glb` motions on this rig (`-`: on the 22-joint
+    /// skeleton again; no argument: say which).
+    Rig(Option<PathBuf>),
     /// `:show`: print the session's program.
     Show,
     /// `:drop N` or `:drop N-M`: delete lines of the session's program (1-based, inclusive).
@@ -147,6 +150,12 @@ pub const COMMANDS: &[CommandDoc] = &[
         "write the session's program, or the current motion as any output kind (listed below; with the program, scores and geometry in its meta)",
     ),
     doc(
+        "rig",
+        &[],
+        "[RIG.bvh | -]",
+        "save .bvh and .glb motions on your character's rig (a BVH: Mixamo or any rig mprog reads; --rig-map is for the command line); `-` goes back to the 22-joint skeleton",
+    ),
+    doc(
         "show",
         &["p"],
         "",
@@ -234,6 +243,9 @@ fn parse_args(cmd: &CommandDoc, args: &str) -> Result<Command, String> {
         "render" => need("an output file").map(|a| Command::Render(unquote(&a).into())),
         "view" => need("an output .html file").map(|a| Command::View(unquote(&a).into())),
         "save" => need("a file").map(|a| Command::Save(unquote(&a).into())),
+        "rig" => Ok(Command::Rig(
+            (!args.is_empty()).then(|| unquote(args).into()),
+        )),
         "eval" => need("an expression or a statement").map(Command::Eval),
         "grad" => need("a statement").map(Command::Grad),
         "gen" => parse_gen(args).map_err(|e| format!("{e}; {}", usage())),

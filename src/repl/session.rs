@@ -64,6 +64,8 @@ pub struct Session {
     model_dir: Option<PathBuf>,
     bundle: Option<ModelBundle>,
     device: Device,
+    /// The rig `:save` puts `.bvh` and `.glb` motions on (`:rig`).
+    rig: Option<crate::formats::Character>,
 }
 
 impl Session {
@@ -76,6 +78,7 @@ impl Session {
             model_dir,
             bundle: None,
             device: Device::flex(),
+            rig: None,
         }
     }
 
@@ -109,6 +112,7 @@ impl Session {
             Command::Score => probe::score(self),
             Command::Render(path) | Command::View(path) => self.export(&path),
             Command::Save(path) => self.save(&path),
+            Command::Rig(path) => self.set_rig(path.as_deref()),
             Command::Show => Reply::text(self.show()),
             Command::Drop { first, last } => self.drop_lines(first, last),
             Command::Clear => {
@@ -372,7 +376,17 @@ impl Session {
             _ => format!(":run {} seed {seed}", solver.name()),
         };
         let device = self.device.clone();
-        let error: &dyn crate::solve::MotionError = &program;
+        // Travelling people face along their path and walkers stay upright, as in `run`.
+        let texts: Vec<Vec<&str>> = req.prompts.iter().map(|p| vec![p.as_str()]).collect();
+        let steering = crate::metrics::crouch::prompt_steering(&texts, false);
+        let along = crate::solve::facing::FacingAlongPath::new(
+            &program,
+            steering.iter().map(|s| s.0).collect(),
+            crate::solve::facing::FACING_WEIGHT,
+            crate::skeleton::FPS,
+        )
+        .upright(steering.iter().map(|s| s.1).collect());
+        let error: &dyn crate::solve::MotionError = &along;
         // Longer than the model makes, or prompts on a timeline: window by window.
         let timelines: Vec<Vec<crate::solve::long::PromptSpan>> = program
             .timelines()
@@ -497,6 +511,26 @@ impl Session {
         }
     }
 
+    /// `:rig`: shows, sets (`FILE`) or drops (`-`) the rig saved motions go on.
+    fn set_rig(&mut self, path: Option<&Path>) -> Reply {
+        const NONE: &str = "no rig: .bvh and .glb motions are saved on the 22-joint skeleton";
+        match path {
+            None => Reply::text(self.rig.as_ref().map_or(NONE.into(), |r| r.summary())),
+            Some(p) if p == Path::new("-") => {
+                self.rig = None;
+                Reply::text(NONE)
+            }
+            Some(p) => match crate::formats::Character::load(p, None) {
+                Ok(rig) => {
+                    let summary = rig.summary();
+                    self.rig = Some(rig);
+                    Reply::text(summary)
+                }
+                Err(e) => Reply::error(e.to_string()),
+            },
+        }
+    }
+
     /// Writes the current motion as any output kind (`:save`, `:render`, `:view`), with
     /// the program's timeline and geometry in its meta and titled with where the motion
     /// came from (after `:gen` the program's prompt is not what was generated).
@@ -518,6 +552,7 @@ impl Session {
             meta: &meta,
             title: &m.origin,
             bvh: &BvhExportOptions::default(),
+            rig: self.rig.as_ref(),
         };
         match write_outputs(&[path.to_path_buf()], &job) {
             Ok(written) => Reply::text(

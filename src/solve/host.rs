@@ -435,10 +435,14 @@ impl<'a> HostObjective<'a> {
             .into_data()
             .try_to_vec::<f32>()
             .expect("f32 terms");
-        out.total = flat
-            .chunks_exact(count)
-            .map(|row| row.iter().sum())
-            .collect();
+        // A program of prompts alone (a timeline) has no term: every sample's error is 0.
+        out.total = match count {
+            0 => vec![0.0; b],
+            _ => flat
+                .chunks_exact(count)
+                .map(|row| row.iter().sum())
+                .collect(),
+        };
         out.statements = count;
         let with_feet = count + usize::from(self.penalized());
         out.values.resize(with_feet, Vec::new());

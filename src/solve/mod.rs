@@ -57,6 +57,7 @@ mod decode;
 mod driver;
 pub mod edit;
 pub mod envelope;
+pub mod facing;
 pub mod feet;
 pub mod host;
 pub mod knobs;

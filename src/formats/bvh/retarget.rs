@@ -98,9 +98,31 @@ fn joint_label(bvh: &Bvh, j: usize) -> String {
     }
 }
 
+/// What [`map_partial`] found: the rig family and a source for each joint it could place.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartialMap {
+    /// As [`JointMap::rig`].
+    pub rig: &'static str,
+    /// Source of each HumanML3D joint, `None` where nothing fits.
+    pub found: [Option<JointSource>; NUM_JOINTS],
+    /// What had to be filled in or guessed.
+    pub warnings: Vec<String>,
+}
+
 /// Builds the joint map: HumanML3D's own names, else the first rig table that fits
 /// ([`rigs::detect`]), else name matching.
 pub fn map_joints(bvh: &Bvh) -> Result<JointMap, BvhErrorKind> {
+    let PartialMap {
+        rig,
+        found,
+        warnings,
+    } = map_partial(bvh);
+    complete(bvh, rig, found, warnings)
+}
+
+/// Where each HumanML3D joint comes from, as far as the names, tables and fills of
+/// [`map_joints`] tell; joints with no source are `None` rather than an error.
+pub fn map_partial(bvh: &Bvh) -> PartialMap {
     let mut found: [Option<JointSource>; NUM_JOINTS] = [None; NUM_JOINTS];
     let mut warnings = Vec::new();
     let humanml3d: Option<Vec<usize>> = JOINT_NAMES.iter().map(|n| bvh.joint_index(n)).collect();
@@ -120,7 +142,20 @@ pub fn map_joints(bvh: &Bvh) -> Result<JointMap, BvhErrorKind> {
     };
     fill_spine(bvh, &mut found, &mut warnings);
     fill_extremities(bvh, &mut found, &mut warnings);
+    PartialMap {
+        rig,
+        found,
+        warnings,
+    }
+}
 
+/// The joint map when every joint has a source, else the error listing the missing ones.
+fn complete(
+    bvh: &Bvh,
+    rig: &'static str,
+    found: [Option<JointSource>; NUM_JOINTS],
+    warnings: Vec<String>,
+) -> Result<JointMap, BvhErrorKind> {
     let missing: Vec<&'static str> = (0..NUM_JOINTS)
         .filter(|&j| found[j].is_none())
         .map(|j| JOINT_NAMES[j])
@@ -184,7 +219,7 @@ fn resolve(bvh: &Bvh, pick: Pick) -> Option<JointSource> {
 }
 
 /// Body-part words per HumanML3D joint, most specific first.
-fn part_words(target: usize, smpl_style: bool) -> &'static [&'static str] {
+pub(crate) fn part_words(target: usize, smpl_style: bool) -> &'static [&'static str] {
     match target {
         0 => &["pelvis", "hips", "hip", "root"],
         1 | 2 => &["hip", "upleg", "upperleg", "thigh"],

@@ -264,7 +264,9 @@ pub fn module_to_ir<'a>(
         );
     }
     let has_errors = c.diags.iter().any(|d| d.severity == Severity::Error);
-    if c.statements.is_empty() && !has_errors {
+    // A timeline alone is a program: prompts in a row, with nothing else to satisfy.
+    let has_timeline = c.header.people.iter().any(|p| p.timeline.len() > 1);
+    if c.statements.is_empty() && !has_errors && !has_timeline {
         c.diags.push(
             Diagnostic::error(
                 crate::lang::codes::EMPTY_PROGRAM,

@@ -253,10 +253,11 @@ pub fn evaluate_until(
             };
             columns.push(col);
         }
-        let per_statement = if columns.len() == 1 {
-            columns.remove(0)
-        } else {
-            Tensor::cat(columns, 1)
+        let per_statement = match columns.len() {
+            // A timeline alone has no statement: nothing to satisfy.
+            0 => Tensor::<2>::zeros([batch, 0], device),
+            1 => columns.remove(0),
+            _ => Tensor::cat(columns, 1),
         };
         let total = per_statement.clone().sum_dim(1).reshape([batch]);
         Evaluation {

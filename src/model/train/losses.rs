@@ -1,6 +1,7 @@
 //! The loss of one training batch: masked x0 MSE plus MDM's geometric terms (foot
 //! contact, velocity) and the extra root-column MSE.
 
+use super::augment::noisy_vectors;
 use super::text::TrainText;
 use crate::dataset::FEATURE_DIM;
 use crate::features::layout::{CONTACT, RIC, ROOT_Y, ROOT_YAW_VEL};
@@ -9,6 +10,7 @@ use crate::model::batch::HostBatch;
 use crate::model::config::TrainConfig;
 use crate::model::denoiser::{Denoiser, DenoiserInput, Mdm};
 use crate::model::noise::NoiseSource;
+use crate::model::prompt::{SentenceBatch, TextBatch};
 use crate::model::schedule::NoiseSchedule;
 use crate::skeleton::{BONE_LENGTHS, FOOT_LEFT, FOOT_RIGHT, NUM_JOINTS, PARENTS};
 use burn::prelude::*;
@@ -32,10 +34,18 @@ pub(crate) fn to_device(
         .collect();
     let valid: Tensor<3> = Tensor::from_data(TensorData::new(valid, [b, n, 1]), device);
     let captions: Vec<&str> = batch.captions.iter().map(String::as_str).collect();
+    let text = match text.batch(&captions, device) {
+        TextBatch::Sentences(s) if batch.text_noise > 0.0 => {
+            let (vectors, mirrored) =
+                noisy_vectors(s.vectors, s.mirrored, batch.text_noise, batch.noise_seed);
+            TextBatch::Sentences(SentenceBatch { vectors, mirrored })
+        }
+        other => other,
+    };
     let input = DenoiserInput {
         x_t: x0.clone(),
         timesteps: batch.timesteps.clone(),
-        text: text.batch(&captions, device),
+        text,
         keep_text: Tensor::from_data(TensorData::new(batch.keep_text.clone(), [b]), device),
         padding: Some(Tensor::from_data(
             TensorData::new(batch.padding.clone(), [b, n]),

@@ -28,10 +28,12 @@
 //! A checkpoint is written whole into `ckpt.new/` and then swapped in by renames, so a
 //! kill at any moment leaves either the old or the new checkpoint complete.
 
+pub mod augment;
 mod checkpoint;
 pub mod control;
 mod log;
 mod losses;
+pub mod paraphrase;
 pub mod text;
 
 pub use log::read_curve;
@@ -176,6 +178,8 @@ impl TrainRun<'_> {
         let mut cfg = self.config.clone();
         cfg.cond_drop = 0.0;
         cfg.word_drop = 0.0;
+        cfg.text_noise = 0.0;
+        cfg.hold_pad = 0.0;
         let mut total = 0.0;
         let rounds = 4;
         for r in 0..rounds {
@@ -201,7 +205,8 @@ impl TrainRun<'_> {
             ));
         }
         let plain = self.device.clone();
-        let text = self.train_text(&plain)?;
+        let mut text = self.train_text(&plain)?;
+        let augment = self.caption_augment(&mut text, &plain)?;
         let device = plain.clone().autodiff();
         let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
         let mut ck = self.load_or_init(&text, &device, &plain)?;
@@ -219,7 +224,10 @@ impl TrainRun<'_> {
                 break;
             }
             let step = ck.state.step;
-            let batch = draw_batch(self.data, &train, cfg, step);
+            let mut batch = draw_batch(self.data, &train, cfg, step);
+            if let Some(a) = &augment {
+                a.apply(&mut batch.captions, cfg.seed, step);
+            }
             let loss = batch_loss(&ck.model, &schedule, &batch, &text, &geometric, &device);
             let value = loss.clone().into_scalar::<f32>();
             if !value.is_finite() {

@@ -26,8 +26,10 @@ pub enum TrainText {
     Sentences {
         /// Encoder and caption index (also what the bundle ships).
         prompts: Box<SentencePrompts>,
-        /// Caption → row of `prompts.captions`.
+        /// Caption (or paraphrase) → row of `table`.
         rows: HashMap<String, usize>,
+        /// `prompts.captions`' vectors, then the paraphrases' ([`TrainText::add_wordings`]).
+        table: Box<Tensor<2>>,
     },
 }
 
@@ -44,9 +46,30 @@ impl TrainText {
             .enumerate()
             .map(|(i, c)| (c.clone(), i))
             .collect();
+        let table = Box::new(captions.embeddings().clone());
         TrainText::Sentences {
             prompts: Box::new(SentencePrompts::new(encoder, captions, lengths)),
             rows,
+            table,
+        }
+    }
+
+    /// Adds the rows of `extra` (paraphrases and their side-swapped twins) to the
+    /// sentence table, so a step looks them up instead of running the encoder.
+    pub fn add_wordings(&mut self, extra: &CaptionIndex) {
+        if let TrainText::Sentences { rows, table, .. } = self {
+            let base = table.dims()[0];
+            let mut added = 0;
+            for (i, c) in extra.captions().iter().enumerate() {
+                if !rows.contains_key(c) {
+                    added += 1;
+                }
+                rows.entry(c.clone()).or_insert(base + i);
+            }
+            if added > 0 {
+                let more = extra.embeddings().clone().to_device(&table.device());
+                **table = Tensor::cat(vec![(**table).clone(), more], 0);
+            }
         }
     }
 
@@ -71,7 +94,11 @@ impl TrainText {
     pub fn batch(&self, captions: &[&str], device: &Device) -> TextBatch {
         match self {
             TrainText::Words(v) => TextBatch::Words(TokenBatch::new(v, captions, device)),
-            TrainText::Sentences { prompts, rows } => {
+            TrainText::Sentences {
+                prompts,
+                rows,
+                table: known,
+            } => {
                 // Each caption, then each caption with its sides swapped (the side input's
                 // other half; the data's mirrored copies hold most of them).
                 let swapped: Vec<String> = captions.iter().map(|c| swap_side_words(c)).collect();
@@ -80,7 +107,7 @@ impl TrainText {
                     .copied()
                     .chain(swapped.iter().map(String::as_str))
                     .collect();
-                let known = prompts.captions.embeddings();
+                let n_known = known.dims()[0];
                 let mut extra: Vec<&str> = Vec::new();
                 let ids: Vec<i64> = all
                     .iter()
@@ -91,10 +118,11 @@ impl TrainText {
                                 extra.push(c);
                                 extra.len() - 1
                             });
-                            (rows.len() + k) as i64
+                            (n_known + k) as i64
                         }
                     })
                     .collect();
+                let known: &Tensor<2> = known;
                 let table = if extra.is_empty() {
                     known.clone()
                 } else {

@@ -1,0 +1,41 @@
+//! The Blender add-on (`integrations/blender/mprog_blender/`), enabled headless in Blender's
+//! own Python from a zip, generates 4 s of "a person walks forward" onto the active
+//! armature (the Mixamo-named test rig, placed, turned and scaled): a new action of at least
+//! 70 frames in which the hips move, every bone where Blender's own import of the same
+//! motion puts it; a program with a typo is refused with its diagnostic at its line.
+//! Needs Blender (3.4: `apt-get install blender python3-numpy`) and the shipped model:
+//! `cargo test --test blender_addon -- --ignored --nocapture`.
+
+use std::process::Command;
+
+#[test]
+#[ignore = "needs Blender and the shipped model; run by hand"]
+fn the_addon_generates_onto_the_active_armature() {
+    if Command::new("blender").arg("--version").output().is_err() {
+        println!("SKIPPED: blender is not installed");
+        return;
+    }
+    let root = env!("CARGO_MANIFEST_DIR");
+    let scripts = tempfile::tempdir().unwrap();
+    let out = Command::new("blender")
+        .args(["-b", "--factory-startup", "--python"])
+        .arg(format!("{root}/integrations/blender/tests/test_addon.py"))
+        .arg("--")
+        .arg(format!("{root}/tests/fixtures/rigs/mixamo_tall.bvh"))
+        .env("MPROG_BIN", env!("CARGO_BIN_EXE_mprog"))
+        .env("BLENDER_USER_SCRIPTS", scripts.path())
+        .current_dir(root)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let report: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("mprog_blender_test"))
+        .collect();
+    println!("{}", report.join("\n"));
+    assert!(
+        out.status.success() && report.iter().any(|l| l.contains(": OK")),
+        "the add-on test failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
