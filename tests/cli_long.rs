@@ -20,6 +20,23 @@ fn run(args: &[&str]) -> Output {
     bin().args(args).output().unwrap()
 }
 
+/// `mprog run PROG -o JSON` with a short chain (20 steps, 4 late steps of 30 iterations).
+fn run_short(prog: &std::path::Path, json: &std::path::Path) -> Output {
+    run(&[
+        "run",
+        prog.to_str().unwrap(),
+        "--no-baseline",
+        "--knob",
+        "steps=20",
+        "--knob",
+        "late_steps=4",
+        "--knob",
+        "k_late=30",
+        "-o",
+        json.to_str().unwrap(),
+    ])
+}
+
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).to_string()
 }
@@ -105,19 +122,7 @@ fn a_timeline_program_meets_constraints_in_its_first_and_last_windows() {
     )
     .unwrap();
     let json = dir.path().join("t.json");
-    let out = run(&[
-        "run",
-        prog.to_str().unwrap(),
-        "--no-baseline",
-        "--knob",
-        "steps=20",
-        "--knob",
-        "late_steps=4",
-        "--knob",
-        "k_late=30",
-        "-o",
-        json.to_str().unwrap(),
-    ]);
+    let out = run_short(&prog, &json);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("in 2 windows"), "{err}");
@@ -204,19 +209,7 @@ fn a_timeline_alone_is_a_program() {
     let out = run(&["check", prog.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
     let json = dir.path().join("t.json");
-    let out = run(&[
-        "run",
-        prog.to_str().unwrap(),
-        "--no-baseline",
-        "--knob",
-        "steps=20",
-        "--knob",
-        "late_steps=4",
-        "--knob",
-        "k_late=30",
-        "-o",
-        json.to_str().unwrap(),
-    ]);
+    let out = run_short(&prog, &json);
     assert!(out.status.success(), "{}", stderr(&out));
     let (m, meta) = read_json(&json);
     assert_eq!(m.len(), 220);

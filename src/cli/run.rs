@@ -328,13 +328,7 @@ pub fn run(mut args: RunArgs) -> Result<()> {
     let req = request(solver.clone());
     // The program's error, and what a walking prompt implies (`solve::facing`).
     let steering = facing_people(&program, &prompts, args.free_facing);
-    let along = mprog::solve::facing::FacingAlongPath::new(
-        &program,
-        steering.iter().map(|s| s.0).collect(),
-        mprog::solve::facing::FACING_WEIGHT,
-        mprog::skeleton::FPS,
-    )
-    .upright(steering.iter().map(|s| s.1).collect());
+    let along = mprog::solve::facing::FacingAlongPath::steered(&program, &steering);
     let result = solve_with_bar(
         &bundle,
         control.as_ref(),

@@ -103,6 +103,37 @@ pub enum BinaryOp {
     Atan2,
 }
 
+impl UnaryOp {
+    /// The op on one number (constant folding, still-pose evaluation).
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            UnaryOp::Neg => -x,
+            UnaryOp::Abs => x.abs(),
+            UnaryOp::Sqrt => (x.max(0.0) + 1e-12).sqrt(),
+            UnaryOp::Relu => x.max(0.0),
+            UnaryOp::Sin => x.sin(),
+            UnaryOp::Cos => x.cos(),
+            UnaryOp::Square => x * x,
+            UnaryOp::OneMinus => 1.0 - x,
+        }
+    }
+}
+
+impl BinaryOp {
+    /// The op on two numbers (constant folding, still-pose evaluation).
+    pub fn apply(self, a: f64, b: f64) -> f64 {
+        match self {
+            BinaryOp::Add => a + b,
+            BinaryOp::Sub => a - b,
+            BinaryOp::Mul => a * b,
+            BinaryOp::Div => a / b,
+            BinaryOp::Min => a.min(b),
+            BinaryOp::Max => a.max(b),
+            BinaryOp::Atan2 => a.atan2(b),
+        }
+    }
+}
+
 /// One tensor op.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Op {

@@ -379,13 +379,7 @@ impl Session {
         // Travelling people face along their path and walkers stay upright, as in `run`.
         let texts: Vec<Vec<&str>> = req.prompts.iter().map(|p| vec![p.as_str()]).collect();
         let steering = crate::metrics::crouch::prompt_steering(&texts, false);
-        let along = crate::solve::facing::FacingAlongPath::new(
-            &program,
-            steering.iter().map(|s| s.0).collect(),
-            crate::solve::facing::FACING_WEIGHT,
-            crate::skeleton::FPS,
-        )
-        .upright(steering.iter().map(|s| s.1).collect());
+        let along = crate::solve::facing::FacingAlongPath::steered(&program, &steering);
         let error: &dyn crate::solve::MotionError = &along;
         // Longer than the model makes, or prompts on a timeline: window by window.
         let timelines: Vec<Vec<crate::solve::long::PromptSpan>> = program

@@ -59,6 +59,18 @@ impl<'a> FacingAlongPath<'a> {
         }
     }
 
+    /// `inner` with each person's `(facing, upright)` terms (as
+    /// `metrics::crouch::prompt_steering` gives them) at the default weights, 20 fps.
+    pub fn steered(inner: &'a dyn MotionError, steering: &[(bool, bool)]) -> Self {
+        Self::new(
+            inner,
+            steering.iter().map(|s| s.0).collect(),
+            FACING_WEIGHT,
+            crate::skeleton::FPS,
+        )
+        .upright(steering.iter().map(|s| s.1).collect())
+    }
+
     /// Also keeps the people marked `true` upright (the dip term).
     pub fn upright(mut self, people: Vec<bool>) -> Self {
         self.upright = people;

@@ -18,8 +18,8 @@ pub struct BvhError {
     pub kind: BvhErrorKind,
 }
 
-/// `origin` or `origin:line`.
-struct Location<'a>(&'a str, Option<usize>);
+/// `origin` or `origin:line` (also the rig errors' location).
+pub(crate) struct Location<'a>(pub(crate) &'a str, pub(crate) Option<usize>);
 
 impl fmt::Display for Location<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

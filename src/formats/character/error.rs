@@ -3,7 +3,7 @@
 //! `rig.bvh:12: …` as compilers do. The rig is untrusted input: every way it can fail to
 //! map is one of these, never a panic.
 
-use std::fmt;
+use crate::formats::bvh::error::Location;
 
 /// An error about a rig, a mapping file or a motion put on a rig.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -15,17 +15,6 @@ pub struct RigError {
     pub line: Option<usize>,
     /// What is wrong.
     pub kind: RigErrorKind,
-}
-
-struct Location<'a>(&'a str, Option<usize>);
-
-impl fmt::Display for Location<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.1 {
-            Some(line) => write!(f, "{}:{line}", self.0),
-            None => write!(f, "{}", self.0),
-        }
-    }
 }
 
 /// A HumanML3D joint the rig lacks, and the rig joints that might be it.

@@ -186,7 +186,7 @@ impl Builder {
     /// Elementwise unary op.
     pub fn unary(&mut self, op: UnaryOp, arg: NodeId, span: Span) -> NodeId {
         if let Some(v) = self.const_of(arg) {
-            let out: Vec<f64> = v.iter().map(|&x| fold_unary(op, f64::from(x))).collect();
+            let out: Vec<f64> = v.iter().map(|&x| op.apply(f64::from(x))).collect();
             return self.konst(&out, span);
         }
         let channels = self.nodes[arg].channels;
@@ -201,7 +201,7 @@ impl Builder {
                 .map(|i| {
                     let xa = f64::from(x[i.min(x.len() - 1)]);
                     let yb = f64::from(y[i.min(y.len() - 1)]);
-                    fold_binary(op, xa, yb)
+                    op.apply(xa, yb)
                 })
                 .collect();
             return self.konst(&out, span);
@@ -308,30 +308,5 @@ impl Builder {
             return self.konst(&[f64::from(u8::from(all))], span);
         }
         self.node_like(Op::Less { a, b }, span, &[a, b], 1)
-    }
-}
-
-fn fold_unary(op: UnaryOp, x: f64) -> f64 {
-    match op {
-        UnaryOp::Neg => -x,
-        UnaryOp::Abs => x.abs(),
-        UnaryOp::Sqrt => (x.max(0.0) + 1e-12).sqrt(),
-        UnaryOp::Relu => x.max(0.0),
-        UnaryOp::Sin => x.sin(),
-        UnaryOp::Cos => x.cos(),
-        UnaryOp::Square => x * x,
-        UnaryOp::OneMinus => 1.0 - x,
-    }
-}
-
-fn fold_binary(op: BinaryOp, a: f64, b: f64) -> f64 {
-    match op {
-        BinaryOp::Add => a + b,
-        BinaryOp::Sub => a - b,
-        BinaryOp::Mul => a * b,
-        BinaryOp::Div => a / b,
-        BinaryOp::Min => a.min(b),
-        BinaryOp::Max => a.max(b),
-        BinaryOp::Atan2 => a.atan2(b),
     }
 }

@@ -5,7 +5,7 @@
 //! floor or turned about the vertical (heights, relative heights, distances between
 //! joints; not ground positions or facing).
 
-use crate::lang::ir::{BinaryOp, Ir, NodeId, Op, Statement, UnaryOp};
+use crate::lang::ir::{Ir, NodeId, Op, Statement};
 use crate::skeleton::NUM_JOINTS;
 
 /// One person's joints (metres, Y up).
@@ -169,8 +169,8 @@ pub fn eval_node(ir: &Ir, nodes: &[NodeId], root: NodeId, p: &Joints) -> (Vec<f6
                         .collect(),
                 }
             }
-            Op::Unary { op, arg } => get(*arg).map(|x| unary(*op, x)),
-            Op::Binary { op, a, b } => Val::zip(get(*a), get(*b), |x, y| binary(*op, x, y)),
+            Op::Unary { op, arg } => get(*arg).map(|x| op.apply(x)),
+            Op::Binary { op, a, b } => Val::zip(get(*a), get(*b), |x, y| op.apply(x, y)),
             Op::SumChannels(a) => get(*a).per_lane(1, |x| vec![x.iter().sum()]),
             Op::Norm(a) => get(*a).per_lane(1, |x| {
                 vec![(x.iter().map(|v| v * v).sum::<f64>() + 1e-12).sqrt()]
@@ -218,31 +218,6 @@ pub fn eval_node(ir: &Ir, nodes: &[NodeId], root: NodeId, p: &Joints) -> (Vec<f6
 pub fn error_on(ir: &Ir, s: &PoseStatement, p: &Joints) -> f64 {
     let root = ir.statements[s.statement].error;
     eval_node(ir, &s.nodes, root, p).0.iter().sum()
-}
-
-fn unary(op: UnaryOp, x: f64) -> f64 {
-    match op {
-        UnaryOp::Neg => -x,
-        UnaryOp::Abs => x.abs(),
-        UnaryOp::Sqrt => (x.max(0.0) + 1e-12).sqrt(),
-        UnaryOp::Relu => x.max(0.0),
-        UnaryOp::Sin => x.sin(),
-        UnaryOp::Cos => x.cos(),
-        UnaryOp::Square => x * x,
-        UnaryOp::OneMinus => 1.0 - x,
-    }
-}
-
-fn binary(op: BinaryOp, a: f64, b: f64) -> f64 {
-    match op {
-        BinaryOp::Add => a + b,
-        BinaryOp::Sub => a - b,
-        BinaryOp::Mul => a * b,
-        BinaryOp::Div => a / b,
-        BinaryOp::Min => a.min(b),
-        BinaryOp::Max => a.max(b),
-        BinaryOp::Atan2 => a.atan2(b),
-    }
 }
 
 /// The ways a body is moved on the floor and turned that a pose statement must not see.
