@@ -30,6 +30,10 @@ pub enum BenchCommand {
     /// each seed and judged; exact against paraphrase success, with `gen`'s
     /// nearest-caption conditioning and literal (`bench/paraphrases.toml`).
     Paraphrases(super::bench_paraphrases::ParaphraseBenchArgs),
+    /// Sentence-level tasks judged like a reviewer (`bench/sentences/`): each program run as
+    /// `mprog run` runs it; per task met, plausible, inside the measured envelope, and right
+    /// by a judge written from the sentence.
+    Sentences(super::bench_sentences::SentenceBenchArgs),
 }
 
 /// Arguments of `mprog bench actions`.
@@ -98,6 +102,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Solvers(args) => super::bench_solvers::run(args),
         BenchCommand::Actions(args) => bench_actions(args),
         BenchCommand::Paraphrases(args) => super::bench_paraphrases::run(args),
+        BenchCommand::Sentences(args) => super::bench_sentences::run(args),
     }
 }
 

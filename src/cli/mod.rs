@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod bench_paraphrases;
+pub mod bench_sentences;
 pub mod bench_solvers;
 pub mod bench_tasks;
 pub mod check;

@@ -64,6 +64,10 @@ pub struct RunArgs {
     /// Skip the unguided comparison sample.
     #[arg(long)]
     no_baseline: bool,
+    /// Leave the feet as the solver made them: no foot cleanup of the result (planted feet
+    /// held in place, as `gen` cleans its samples; the error table is of the cleaned motion).
+    #[arg(long)]
+    raw: bool,
     /// Give the model the prompt as written, even when it lies far from every training
     /// caption (by default such a prompt is replaced by the mean of its nearest captions).
     #[arg(long)]
@@ -210,6 +214,8 @@ fn solve_with_bar(
                 resample,
                 placements: req.placements.clone(),
                 guidance_scale: req.guidance_scale,
+                // Windows are not cleaned: each window's cleanup, with no polish after it,
+                // left a timeline's `at 11s` statement 2 cm short.
                 ..LongRequest::new(Vec::new(), req.frames, req.seed, req.solver.clone())
             };
             solve_long(&prior, &long, error, device, |p: LongProgress| {
@@ -319,7 +325,8 @@ pub fn run(mut args: RunArgs) -> Result<()> {
     };
     let request = |solver: Solver| {
         let req = SolveRequest::new(prompts.clone(), frames, args.seed, solver)
-            .placed(program.placements());
+            .placed(program.placements())
+            .cleaned(!args.raw);
         match &edit {
             Some(e) => req.editing(e.clone()),
             None => req,

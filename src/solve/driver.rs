@@ -2,6 +2,7 @@
 //! noise, decoder), runs the chosen solver and turns its normalised samples into world
 //! motions, features and final errors.
 
+use super::cleanup::{FootCleanup, clean_feet};
 use super::decode::Decoder;
 use super::edit::EditState;
 use super::host::{HostObjective, check_shape};
@@ -41,6 +42,9 @@ pub struct Ctx<'a> {
     pub decoder: Decoder,
     /// The take being edited, if any ([`super::edit`]).
     pub edit: Option<EditState>,
+    /// Clean the result's feet ([`super::cleanup`]): asked for and not an edit (an edit
+    /// cleans by its own settings).
+    pub clean_feet: bool,
 }
 
 /// What a solver hands back: normalised samples and, when it relaxes, a transform per motion.
@@ -50,6 +54,8 @@ pub struct Outcome {
     /// Per motion, applied before the placement.
     pub relax: Option<Vec<Placement>>,
     pub trace: Vec<Vec<f32>>,
+    /// The solver cleaned the feet itself ([`Ctx::clean_feet`]); the driver does not again.
+    pub cleaned: bool,
 }
 
 impl Ctx<'_> {
@@ -250,6 +256,7 @@ pub fn solve(
             .edit
             .as_ref()
             .map(|e| EditState::new(e, req.samples, prior.mean, prior.std, device)),
+        clean_feet: req.clean_feet && req.edit.is_none(),
     };
     let progress: &mut dyn FnMut(Progress) = &mut on_progress;
     let out = req.solver.run(&ctx, progress)?;
@@ -273,9 +280,20 @@ fn finish(
             *v = *v * s + m;
         }
     }
-    if let Some(edit) = &ctx.edit {
-        edit.clean_free_feet(&mut features, ctx.frames);
-        edit.rebuild_seams(&mut features, ctx.frames);
+    match &ctx.edit {
+        Some(edit) => {
+            edit.clean_free_feet(&mut features, ctx.frames);
+            edit.rebuild_seams(&mut features, ctx.frames);
+        }
+        None if ctx.clean_feet && !out.cleaned => {
+            clean_feet(
+                &mut features,
+                ctx.frames,
+                FEATURE_DIM,
+                &FootCleanup::default(),
+            );
+        }
+        None => {}
     }
     let per = ctx.frames * FEATURE_DIM;
     let mut motions = Vec::with_capacity(ctx.samples);

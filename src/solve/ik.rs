@@ -128,6 +128,7 @@ fn run(
         x,
         relax: None,
         trace,
+        cleaned: false,
     })
 }
 

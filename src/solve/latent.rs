@@ -270,6 +270,7 @@ fn run(
     Ok(Outcome {
         x: last,
         relax,
+        cleaned: false,
         trace,
     })
 }

@@ -225,6 +225,7 @@ fn run(
     Ok(Outcome {
         x: host(ctx.hold_final(x)),
         relax: None,
+        cleaned: false,
         trace,
     })
 }

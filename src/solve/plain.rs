@@ -53,6 +53,7 @@ impl SolverConfig for PlainConfig {
         Ok(Outcome {
             x: host(ctx.sample_edited(self.sampler, progress)),
             relax: None,
+            cleaned: false,
             trace: Vec::new(),
         })
     }

@@ -65,6 +65,9 @@ pub struct SolveRequest {
     /// A take to edit instead of starting from noise ([`super::edit`]); its people stand
     /// where the take stands, whatever `placements` says.
     pub edit: Option<Edit>,
+    /// Foot cleanup of the result ([`super::cleanup`]), as `gen` cleans its samples; an
+    /// edit cleans by its own [`Edit::clean_feet`] instead.
+    pub clean_feet: bool,
 }
 
 impl SolveRequest {
@@ -79,6 +82,7 @@ impl SolveRequest {
             placements: None,
             solver,
             edit: None,
+            clean_feet: false,
         }
     }
 
@@ -88,6 +92,11 @@ impl SolveRequest {
             placements: Some(placements),
             ..self
         }
+    }
+
+    /// The same request with the result's feet cleaned (`true`) or left as solved.
+    pub fn cleaned(self, clean_feet: bool) -> Self {
+        SolveRequest { clean_feet, ..self }
     }
 
     /// The same request editing this take.

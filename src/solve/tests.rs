@@ -1090,37 +1090,29 @@ fn max_acceleration(m: &crate::motion::Motion) -> f32 {
 }
 
 #[test]
-fn where_the_program_is_met_the_hold_only_takes_back_the_projections_jerk() {
+fn where_the_program_is_met_the_penalties_do_not_step_alone() {
     let bundle = tiny_bundle();
-    // Without the foot lock, whose own steps the hold's gradient would bend.
-    let guide = |accel_hold, keep_skeleton| {
+    let guide = |accel_hold, foot_lock, envelope| {
         Solver::new(GuideConfig {
             steps: 20,
             fused: Some(FusedSettings {
                 accel_hold,
-                keep_skeleton,
-                foot_lock: 0.0,
-                envelope: 0.0,
+                keep_skeleton: true,
+                foot_lock,
+                envelope,
                 ..FusedSettings::default()
             }),
             ..GuideConfig::default()
         })
     };
     let solve = |s: Solver| run(&bundle, &request(&["a person walks"], s), &always_met);
-    // Nothing to take back: the motion is left as it is.
-    let (free, held) = (solve(guide(0.0, false)), solve(guide(1.0, false)));
+    // Nothing pulls, so the hold, the lock and the envelope have nothing to shape: stepping
+    // on them alone for hundreds of iterations folded a waving person's legs (a 0.15 m
+    // pelvis). Only the skeleton projection acts, the same with or without them.
+    let free = solve(guide(0.0, 0.0, 0.0));
+    let held = solve(guide(1.0, 1.0, 1.0));
     assert_eq!(free.motions[0][0].to_flat(), held.motions[0][0].to_flat());
-    // The projection rebuilds the body bone by bone and adds jerk; the hold's reference is
-    // the joints before it (the feet after it), so it smooths that jerk.
-    let (free, held) = (solve(guide(0.0, true)), solve(guide(1.0, true)));
-    let (a_free, a_held) = (
-        max_acceleration(&free.motions[0][0]),
-        max_acceleration(&held.motions[0][0]),
-    );
-    assert!(
-        a_held < a_free,
-        "peak acceleration: held {a_held}, free {a_free}"
-    );
+    assert!(max_acceleration(&held.motions[0][0]).is_finite());
 }
 
 #[test]
@@ -1265,10 +1257,12 @@ fn a_shared_foot_penalty_keeps_the_sums() {
     assert!((terms.values[0][0] - 1.1).abs() < 1e-6 && (terms.values[1][0] - 2.2).abs() < 1e-6);
     assert!((terms.grads[0][0] - 1.2).abs() < 1e-6 && (terms.grads[0][1] - 0.2).abs() < 1e-6);
     assert!((terms.grads[1][0] - 0.4).abs() < 1e-6 && (terms.grads[1][1] - 1.4).abs() < 1e-6);
-    // Sample 1 has no error: its penalty stays a term of its own.
-    assert_eq!(terms.values.len(), 3);
-    assert_eq!(terms.values[2], vec![0.0, 0.5]);
-    assert_eq!(terms.grads[2], vec![0.0, 0.0, 0.4, 0.4]);
+    // Sample 1 has no error: its penalty is dropped, nothing steps on it alone.
+    assert_eq!(terms.values.len(), 2);
+    assert_eq!(terms.values[0][1], 0.0);
+    assert_eq!(terms.values[1][1], 0.0);
+    assert_eq!(&terms.grads[0][2..], &[0.0, 0.0]);
+    assert_eq!(&terms.grads[1][2..], &[0.0, 0.0]);
 }
 
 /// A stiff term (the wrist's sideways position at frame 3, weighted 50, a kink at its
@@ -1515,4 +1509,68 @@ fn the_reference_pull_keeps_the_legs_near_the_first_sample() {
         ..small_latent()
     });
     assert_refused(&bundle, negative, "ref_root");
+}
+
+#[test]
+fn a_cleaned_result_keeps_its_path_and_does_not_skate_more() {
+    let bundle = tiny_bundle();
+    let solver = Solver::plain(SamplerKind::Ddim(10));
+    let raw = run(
+        &bundle,
+        &request(&["a person walks"], solver.clone()),
+        &always_met,
+    );
+    let req = request(&["a person walks"], solver).cleaned(true);
+    assert!(req.clean_feet && !request(&["a"], Solver::plain(SamplerKind::Ddim(10))).clean_feet);
+    let cleaned = run(&bundle, &req, &always_met);
+    let (a, b) = (&raw.motions[0][0], &cleaned.motions[0][0]);
+    // The cleanup moves the legs, never the root: the pelvis path is the same.
+    for (p, q) in a.frames.iter().zip(&b.frames) {
+        assert!(
+            (p[0] - q[0]).length() < 1e-4,
+            "pelvis {:?} vs {:?}",
+            p[0],
+            q[0]
+        );
+    }
+    assert!(toe_slide(b) <= toe_slide(a) + 1e-4);
+}
+
+/// Horizontal slide of toes on the floor (below 5 cm on both frames), summed over frames
+/// (m): the skating the foot cleanup removes.
+fn toe_slide(m: &crate::motion::Motion) -> f32 {
+    m.frames
+        .windows(2)
+        .flat_map(|w| {
+            [10, 11]
+                .into_iter()
+                .filter(move |&j| w[0][j].y < 0.05 && w[1][j].y < 0.05)
+                .map(move |j| (w[1][j] - w[0][j]).with_y(0.0).length())
+        })
+        .sum()
+}
+
+#[test]
+fn guide_cleans_the_feet_and_meets_the_program_again() {
+    let bundle = tiny_bundle();
+    let guide = || Solver::new(small_guide());
+    let raw = run(
+        &bundle,
+        &request(&["a person walks"], guide()),
+        &pelvis_at_end,
+    );
+    let cleaned = run(
+        &bundle,
+        &request(&["a person walks"], guide()).cleaned(true),
+        &pelvis_at_end,
+    );
+    // One more trace entry: the polish after the cleanup.
+    assert_eq!(cleaned.trace.len(), raw.trace.len() + 1);
+    let (e_raw, e_clean) = (raw.error[0], cleaned.error[0]);
+    assert!(
+        e_clean <= e_raw.max(0.01),
+        "pelvis target: {e_raw} raw, {e_clean} cleaned and polished"
+    );
+    let (a, b) = (&raw.motions[0][0], &cleaned.motions[0][0]);
+    assert!(toe_slide(b) <= toe_slide(a) + 0.05);
 }

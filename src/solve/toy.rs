@@ -77,6 +77,7 @@ impl SolverConfig for ToyConfig {
             x,
             relax: None,
             trace,
+            cleaned: false,
         })
     }
 }

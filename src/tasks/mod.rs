@@ -13,6 +13,7 @@
 pub mod head_height;
 pub mod keyframe;
 pub mod report;
+pub mod sentences;
 pub mod suite;
 
 use crate::features::FEATURE_DIM;
