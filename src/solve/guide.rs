@@ -67,6 +67,17 @@ pub enum StepRule {
 /// Root columns of a feature row: yaw velocity, XZ velocity, height.
 pub(crate) const ROOT_COLUMNS: usize = 4;
 
+/// Column of the root (pelvis) height in a feature row.
+const ROOT_HEIGHT: usize = 3;
+
+/// The lowest and highest pelvis of the training data (m): the minimum and maximum over
+/// the 631,632 frames of `data/combined` (feature column 3). The early steps keep μ's root
+/// height inside it. A pose statement the early root-only steps cannot meet ("lying on
+/// the back" on a standing body) otherwise pushes the height down at every step, with
+/// nothing to stop it: μ's pelvis reached −7.4 m, and the late steps, pulling it back
+/// through the floor penalty smoothed over time, threw the body 2.8 m into the air.
+pub const ROOT_HEIGHT_RANGE: (f32, f32) = (0.046, 1.945);
+
 /// Default weight of the acceleration hold ([`FusedSettings::accel_hold`]). With the
 /// shipped ControlNet on the keyframe family (6 clips, the bench's fast settings) it took
 /// guide's peak acceleration from 0.119 to 0.096 m/frame², under 1.2× the unguided chain's
@@ -439,6 +450,8 @@ struct Inner {
     split: bool,
     /// The root columns' share of each step direction.
     root_scale: f32,
+    /// Keep the root height inside [`ROOT_HEIGHT_RANGE`] after every iteration.
+    bound_root_height: bool,
 }
 
 impl Inner {
@@ -463,6 +476,7 @@ impl Inner {
             // the barrier" met by stopping short of it, against "end past it": 0.76 m short).
             split: fused.split_terms && cfg.step_rule == StepRule::Polyak && late,
             root_scale: if late { fused.late_root_scale } else { 1.0 },
+            bound_root_height: !late,
         }
     }
 }
@@ -484,6 +498,7 @@ fn guide_fused(
         moving,
         split,
         root_scale,
+        bound_root_height,
     }: Inner,
     i: usize,
     at: &dyn Fn(usize) -> String,
@@ -546,6 +561,9 @@ fn guide_fused(
         // columns alone: restricting the direction must not enlarge the step (a pose error
         // with a small root gradient would otherwise push the root height by metres).
         apply_step(cfg, &mut head, &grad, &dir, &total, step, (HEAD, moving));
+        if bound_root_height {
+            clamp_root_height(&mut head, ctx.prior.mean, ctx.prior.std);
+        }
     }
     objective.unlock_feet();
     if skeleton {
@@ -563,6 +581,15 @@ fn guide_fused(
     }
     insert_head(full, FEATURE_DIM, &head);
     Ok(values)
+}
+
+/// Clamps the root height of every normalised `[.., HEAD]` row into [`ROOT_HEIGHT_RANGE`].
+pub(crate) fn clamp_root_height(head: &mut [f32], mean: &[f32], std: &[f32]) {
+    let (m, s) = (mean[ROOT_HEIGHT], std[ROOT_HEIGHT].max(1e-6));
+    let (lo, hi) = ((ROOT_HEIGHT_RANGE.0 - m) / s, (ROOT_HEIGHT_RANGE.1 - m) / s);
+    for row in head.chunks_exact_mut(HEAD) {
+        row[ROOT_HEIGHT] = row[ROOT_HEIGHT].clamp(lo, hi);
+    }
 }
 
 /// The step direction of gradient `g` (`[M, N, width]`): `g` smoothed over frames by

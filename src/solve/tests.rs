@@ -1011,6 +1011,46 @@ fn early_steps_steer_the_root_and_leave_the_pose_to_the_denoiser() {
     );
 }
 
+/// The pelvis 3 m under the floor on every frame: mean hinge in metres.
+fn pelvis_deep(j: Tensor<5>) -> Tensor<1> {
+    let [b, _, n, _, _] = j.dims();
+    (joint(j, 0).narrow(4, 1, 1) + 3.0)
+        .clamp_min(0.0)
+        .reshape([b, n])
+        .mean_dim(1)
+        .reshape([b])
+}
+
+#[test]
+fn early_steps_keep_the_root_height_inside_the_data() {
+    // A statement no pose can meet, steered by the root alone at every step: without a
+    // bound its height went on down at every step (a lying statement took μ's pelvis to
+    // −7.4 m and the late steps threw the body 2.8 m up when they pulled it back).
+    let bundle = tiny_bundle();
+    let cfg = GuideConfig {
+        steps: 100,
+        k_early: 50,
+        late_steps: 0,
+        ..GuideConfig::default()
+    };
+    let r = run(
+        &bundle,
+        &request(&["a person walks"], Solver::new(cfg)),
+        &pelvis_deep,
+    );
+    let lowest = r.motions[0][0]
+        .frames
+        .iter()
+        .map(|f| f[0].y)
+        .fold(f32::MAX, f32::min);
+    let (lo, _) = super::guide::ROOT_HEIGHT_RANGE;
+    assert!(lowest >= lo - 1e-3, "pelvis down to {lowest} m");
+    assert!(
+        lowest < lo + 0.01,
+        "the bound is where it stopped: {lowest} m"
+    );
+}
+
 #[test]
 fn the_acceleration_hold_adds_its_gradient_but_not_its_value() {
     let (_, decoder, x) = random_case(1, 1);
