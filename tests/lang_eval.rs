@@ -494,7 +494,8 @@ fn cases() -> Vec<(&'static str, usize, &'static str, Reference)> {
                 let ftf = over_all(|t| {
                     let (fa, fb) = (facing(m, 0, t), facing(m, 1, t));
                     let d = sub(p(m, 1, t, 0), p(m, 0, t, 0));
-                    norm(add(fa, fb)) + relu(0.8 - dot(fa, normalize([d[0], 0.0, d[2]])))
+                    relu(norm(add(fa, fb)) - 0.2)
+                        + relu(0.8 - dot(fa, normalize([d[0], 0.0, d[2]])))
                 });
                 let torso = over_all(|t| {
                     let mut e = 0.0;
