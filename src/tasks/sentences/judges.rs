@@ -138,6 +138,15 @@ fn in_place(c: &mut Checks, m: &Motion, limit: f32) {
     );
 }
 
+/// The pelvis stays at least `least` metres up over the frames `w` (standing).
+fn stands(c: &mut Checks, m: &Motion, w: std::ops::Range<usize>, least: f32) {
+    let lo = min_over(w, |t| m.frames[t][PELVIS].y);
+    c.add(
+        lo >= least,
+        format!("pelvis down to {lo:.2} m (≥ {least:.2}, standing)"),
+    );
+}
+
 /// Facing along the path while walking: at least 75 % of the frames moving faster than
 /// 0.4 m/s face within 45° of the travel (judges.py's rule).
 fn walks_facing(c: &mut Checks, m: &Motion, who: &str) {

@@ -57,11 +57,7 @@ pub(super) fn s18(p: &[Motion]) -> Checks {
         tilt <= 20.0,
         format!("spine tilts up to {tilt:.0}° over the last 1 s (≤ 20)"),
     );
-    let lo = min_over(w.clone(), |t| m.frames[t][PELVIS].y);
-    c.add(
-        lo >= 0.80,
-        format!("pelvis down to {lo:.2} m (≥ 0.80, standing)"),
-    );
+    stands(&mut c, m, w.clone(), 0.80);
     let off = min_over(w, |t| d[t]);
     c.add(
         off >= 0.25,
@@ -214,11 +210,7 @@ pub(super) fn s22(p: &[Motion]) -> Checks {
         format!("hands {under:+.2} m from the chest, {over:+.2} m from the neck in height (≥ -0.30, ≤ +0.05)"),
     );
     // "stands still".
-    let lo = min_over(w.clone(), |t| m.frames[t][PELVIS].y);
-    c.add(
-        lo >= 0.80,
-        format!("pelvis down to {lo:.2} m (≥ 0.80, standing)"),
-    );
+    stands(&mut c, m, w.clone(), 0.80);
     still(&mut c, m, w, "last 1.5 s: ");
     c
 }

@@ -63,11 +63,7 @@ pub(super) fn s11(p: &[Motion]) -> Checks {
         d <= 0.20,
         format!("last 1.5 s: pelvis wanders {d:.2} m (≤ 0.20, still)"),
     );
-    let lo = min_over(w, |t| m.frames[t][PELVIS].y);
-    c.add(
-        lo >= 0.75,
-        format!("pelvis down to {lo:.2} m (≥ 0.75, standing)"),
-    );
+    stands(&mut c, m, w, 0.75);
     walks_facing(&mut c, m, "");
     c
 }

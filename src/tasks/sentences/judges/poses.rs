@@ -142,11 +142,7 @@ pub(super) fn s03(p: &[Motion]) -> Checks {
         hold <= 0.15,
         format!("right wrist wanders {hold:.2} m (≤ 0.15, held)"),
     );
-    let lo = min_over(w, |t| m.frames[t][PELVIS].y);
-    c.add(
-        lo >= 0.75,
-        format!("pelvis down to {lo:.2} m (≥ 0.75, standing)"),
-    );
+    stands(&mut c, m, w, 0.75);
     in_place(&mut c, m, 0.4);
     c
 }
@@ -258,11 +254,7 @@ pub(super) fn s06(p: &[Motion]) -> Checks {
         ank <= 0.15,
         format!("ankles up to {ank:.2} m (≤ 0.15, both feet down)"),
     );
-    let lo = min_over(w, |t| m.frames[t][PELVIS].y);
-    c.add(
-        lo >= 0.75,
-        format!("pelvis down to {lo:.2} m (≥ 0.75, standing)"),
-    );
+    stands(&mut c, m, w, 0.75);
     in_place(&mut c, m, 0.3);
     c
 }
@@ -348,11 +340,7 @@ pub(super) fn s08(p: &[Motion]) -> Checks {
         slide <= 0.10,
         format!("left foot wanders {slide:.2} m (≤ 0.10, no hopping)"),
     );
-    let lo = min_over(w, |t| m.frames[t][PELVIS].y);
-    c.add(
-        lo >= 0.70,
-        format!("pelvis down to {lo:.2} m (≥ 0.70, standing)"),
-    );
+    stands(&mut c, m, w, 0.70);
     c
 }
 
