@@ -425,7 +425,10 @@ fn clean_and_polish(
     clean_feet(x, ctx.frames, FEATURE_DIM, &FootCleanup::default());
     normalize_slice(x, mean, std).map_err(|e| SolveError::Invalid(e.to_string()))?;
     let step = (cfg.tau as f64 * cfg.sigma_hat(schedule.posterior(0).variance_clipped)) as f32;
-    let inner = Inner::at(cfg, fused, 0, POLISH_ITERATIONS, step);
+    let inner = Inner {
+        fix_envelope: true,
+        ..Inner::at(cfg, fused, 0, POLISH_ITERATIONS, step)
+    };
     let at = |it: usize| format!("the polish after the foot cleanup (iteration {})", it + 1);
     guide_fused(ctx, cfg, objective, x, inner, 0, &at)
 }
@@ -452,6 +455,9 @@ struct Inner {
     root_scale: f32,
     /// Keep the root height inside [`ROOT_HEIGHT_RANGE`] after every iteration.
     bound_root_height: bool,
+    /// Step on the penalties where the program is met but the motion is outside the
+    /// envelope (the polish; [`TermGradients::share_penalty`]).
+    fix_envelope: bool,
 }
 
 impl Inner {
@@ -477,6 +483,7 @@ impl Inner {
             split: fused.split_terms && cfg.step_rule == StepRule::Polyak && late,
             root_scale: if late { fused.late_root_scale } else { 1.0 },
             bound_root_height: !late,
+            fix_envelope: false,
         }
     }
 }
@@ -499,6 +506,7 @@ fn guide_fused(
         split,
         root_scale,
         bound_root_height,
+        fix_envelope,
     }: Inner,
     i: usize,
     at: &dyn Fn(usize) -> String,
@@ -528,7 +536,8 @@ fn guide_fused(
             objective.eval_terms(&head, &mut terms)?;
             values.clone_from(&terms.total);
             ensure_finite(&values, "guide", "error", || at(it))?;
-            terms.share_penalty();
+            let alone = outside_alone(objective, fix_envelope);
+            terms.share_penalty(&alone);
             combined.fill(0.0);
             for (term, g) in terms.values.iter().zip(terms.grads.iter_mut()) {
                 ensure_finite(term, "guide", "error", || at(it))?;
@@ -546,12 +555,14 @@ fn guide_fused(
         // `grad` is; the program's own error is what gets reported. A sample whose error
         // is 0 takes no step: the penalty alone has nothing to shape
         // ([`TermGradients::share_penalty`]).
+        let alone = outside_alone(objective, fix_envelope);
         total.clear();
         total.extend(
             values
                 .iter()
                 .zip(objective.penalty())
-                .map(|(e, p)| if *e > 0.0 { e + p } else { 0.0 }),
+                .zip(&alone)
+                .map(|((e, p), a)| if *e > 0.0 || *a { e + p } else { 0.0 }),
         );
         ensure_finite(&values, "guide", "error", || at(it))?;
         ensure_finite(&grad, "guide", "gradient", || at(it))?;
@@ -581,6 +592,16 @@ fn guide_fused(
     }
     insert_head(full, FEATURE_DIM, &head);
     Ok(values)
+}
+
+/// Per sample, whether its penalties step on their own: with `fix_envelope`, where the
+/// last evaluation left the motion outside the envelope.
+fn outside_alone(objective: &HostObjective, fix_envelope: bool) -> Vec<bool> {
+    objective
+        .outside()
+        .iter()
+        .map(|&o| fix_envelope && o > 0.0)
+        .collect()
 }
 
 /// Clamps the root height of every normalised `[.., HEAD]` row into [`ROOT_HEIGHT_RANGE`].

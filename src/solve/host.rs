@@ -160,6 +160,8 @@ pub struct HostObjective<'a> {
     envelope: Option<EnvelopeGuard>,
     /// The two penalties per sample at the last evaluation (zeros without them).
     penalty: Vec<f32>,
+    /// The envelope's share of `penalty` per sample (zeros without the guard).
+    outside: Vec<f32>,
     /// Rigid XZ transform per motion `[B·P]`, applied in the person's frame before its
     /// placement (`latent`'s relaxation, [`Self::set_rigid`]).
     rigid: Option<Vec<Placement>>,
@@ -196,6 +198,7 @@ impl<'a> HostObjective<'a> {
             accel: None,
             envelope: None,
             penalty: vec![0.0; batch],
+            outside: vec![0.0; batch],
             rigid: None,
             local: Vec::new(),
             g_rigid: Vec::new(),
@@ -277,6 +280,7 @@ impl<'a> HostObjective<'a> {
         self.accel = None;
         self.envelope = None;
         self.penalty.fill(0.0);
+        self.outside.fill(0.0);
     }
 
     /// The foot and acceleration penalties per sample at the last [`eval`](Self::eval):
@@ -286,20 +290,29 @@ impl<'a> HostObjective<'a> {
         &self.penalty
     }
 
+    /// The envelope guard's part of [`Self::penalty`] per sample at the last evaluation:
+    /// above 0 where the motion leaves the real envelope.
+    pub fn outside(&self) -> &[f32] {
+        &self.outside
+    }
+
     /// Whether a penalty is set.
     fn penalized(&self) -> bool {
         self.feet.is_some() || self.accel.is_some() || self.envelope.is_some()
     }
 
     /// The penalties of the current joints per sample; their gradient added to `g`.
-    fn eval_penalties(&self, g: &mut [f32]) -> Vec<f32> {
+    fn eval_penalties(&mut self, g: &mut [f32]) -> Vec<f32> {
         let mut penalty = vec![0.0; self.batch];
+        let outside = self
+            .envelope
+            .as_ref()
+            .map(|guard| guard.eval(&self.joints, g));
+        self.outside = outside.clone().unwrap_or_else(|| vec![0.0; self.batch]);
         for p in [
             self.feet.as_ref().map(|lock| lock.eval(&self.joints, g)),
             self.accel.as_ref().map(|hold| hold.eval(&self.joints, g)),
-            self.envelope
-                .as_ref()
-                .map(|guard| guard.eval(&self.joints, g)),
+            outside,
         ]
         .into_iter()
         .flatten()
@@ -577,16 +590,21 @@ impl TermGradients {
     /// whole error did. As a term of its own, with its own step, the penalty held the feet
     /// so firmly that two people could not close the gap between their hands (handshake
     /// contact 0.52 m against 0.01 m without it).
-    pub fn share_penalty(&mut self) {
+    ///
+    /// Samples marked in `alone` (where the error is 0 but the motion is outside the real
+    /// envelope, [`HostObjective::outside`]) keep the penalty as a term of its own: it has
+    /// a snap or a joint under the floor to remove there, not just feet to hold.
+    pub fn share_penalty(&mut self, alone: &[bool]) {
         if self.values.len() <= self.statements {
             return;
         }
-        let (penalty, g_pen) = (
+        let (mut penalty, mut g_pen) = (
             self.values.pop().unwrap_or_default(),
             self.grads.pop().unwrap_or_default(),
         );
         let samples = self.total.len();
         let per = g_pen.len() / samples.max(1);
+        let kept = (0..samples).any(|b| self.total[b] <= 0.0 && alone.get(b) == Some(&true));
         for b in 0..samples {
             let total = self.total[b];
             if total <= 0.0 {
@@ -605,6 +623,17 @@ impl TermGradients {
                     *g += w * p;
                 }
             }
+        }
+        if kept {
+            for b in 0..samples {
+                if self.total[b] <= 0.0 && alone.get(b) == Some(&true) {
+                    continue;
+                }
+                penalty[b] = 0.0;
+                g_pen[b * per..(b + 1) * per].fill(0.0);
+            }
+            self.values.push(penalty);
+            self.grads.push(g_pen);
         }
     }
 }

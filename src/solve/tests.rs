@@ -1292,7 +1292,8 @@ fn a_shared_foot_penalty_keeps_the_sums() {
         ],
         statements: 2,
     };
-    terms.share_penalty();
+    let unshared = terms.clone();
+    terms.share_penalty(&[]);
     // Sample 0: the penalty goes 1/3 to the first term, 2/3 to the second.
     assert!((terms.values[0][0] - 1.1).abs() < 1e-6 && (terms.values[1][0] - 2.2).abs() < 1e-6);
     assert!((terms.grads[0][0] - 1.2).abs() < 1e-6 && (terms.grads[0][1] - 0.2).abs() < 1e-6);
@@ -1303,6 +1304,15 @@ fn a_shared_foot_penalty_keeps_the_sums() {
     assert_eq!(terms.values[1][1], 0.0);
     assert_eq!(&terms.grads[0][2..], &[0.0, 0.0]);
     assert_eq!(&terms.grads[1][2..], &[0.0, 0.0]);
+
+    // Sample 1 outside the envelope: its penalty stays a term of its own there, and
+    // sample 0's, shared out as before, is not counted twice.
+    let mut terms = unshared;
+    terms.share_penalty(&[true, true]);
+    assert_eq!(terms.values.len(), 3);
+    assert!((terms.values[0][0] - 1.1).abs() < 1e-6);
+    assert_eq!(terms.values[2], vec![0.0, 0.5]);
+    assert_eq!(terms.grads[2], vec![0.0, 0.0, 0.4, 0.4]);
 }
 
 /// A stiff term (the wrist's sideways position at frame 3, weighted 50, a kink at its
@@ -1613,4 +1623,31 @@ fn guide_cleans_the_feet_and_meets_the_program_again() {
     );
     let (a, b) = (&raw.motions[0][0], &cleaned.motions[0][0]);
     assert!(toe_slide(b) <= toe_slide(a) + 0.05);
+}
+
+#[test]
+fn outside_is_the_envelope_share_of_the_penalty() {
+    // The polish steps on the penalties where the program is met only while the motion is
+    // outside the envelope (`HostObjective::outside`); a random motion is far outside it.
+    let (_, decoder, x) = random_case(1, 1);
+    let dev = Device::flex();
+    let zero = |j: Tensor<5>| j.sum_dim(4).sum_dim(3).sum_dim(2).sum_dim(1).reshape([1]) * 0.0;
+    let mut obj = HostObjective::new(&zero, &decoder, 1, FRAMES, &dev);
+    let head = extract_head(&x, FEATURE_DIM);
+    let mut g = vec![0.0; head.len()];
+    obj.eval(&head, &mut g).unwrap();
+    assert_eq!(obj.outside(), &[0.0], "no guard, nothing outside");
+    obj.keep_in_envelope(1.0);
+    obj.hold_accel(&head, 1.0);
+    obj.eval(&head, &mut g).unwrap();
+    let (outside, penalty) = (obj.outside()[0], obj.penalty()[0]);
+    assert!(outside > 0.0, "a random motion is inside the envelope");
+    // The acceleration hold's reference is this motion: it adds nothing here.
+    assert!(
+        (outside - penalty).abs() <= 1e-6 * penalty,
+        "{outside} vs {penalty}"
+    );
+    obj.unlock_feet();
+    obj.eval(&head, &mut g).unwrap();
+    assert_eq!(obj.outside(), &[0.0]);
 }
