@@ -604,7 +604,10 @@ impl TermGradients {
         );
         let samples = self.total.len();
         let per = g_pen.len() / samples.max(1);
-        let kept = (0..samples).any(|b| self.total[b] <= 0.0 && alone.get(b) == Some(&true));
+        // Samples met whose penalty stays a term of its own.
+        let own: Vec<bool> = (0..samples)
+            .map(|b| self.total[b] <= 0.0 && alone.get(b) == Some(&true))
+            .collect();
         for b in 0..samples {
             let total = self.total[b];
             if total <= 0.0 {
@@ -624,11 +627,8 @@ impl TermGradients {
                 }
             }
         }
-        if kept {
-            for b in 0..samples {
-                if self.total[b] <= 0.0 && alone.get(b) == Some(&true) {
-                    continue;
-                }
+        if own.contains(&true) {
+            for b in (0..samples).filter(|&b| !own[b]) {
                 penalty[b] = 0.0;
                 g_pen[b * per..(b + 1) * per].fill(0.0);
             }
