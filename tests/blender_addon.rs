@@ -3,8 +3,10 @@
 //! armature (the Mixamo-named test rig, placed, turned and scaled): a new action of at least
 //! 70 frames in which the hips move, every bone where Blender's own import of the same
 //! motion puts it; a program with a typo is refused with its diagnostic at its line.
-//! Needs Blender (3.4: `apt-get install blender python3-numpy`) and the shipped model:
-//! `cargo test --test blender_addon -- --ignored --nocapture`.
+//! In Blender's interface (a virtual X server), the panel draws, *Generate motion* runs in
+//! the background to a new action, and Esc stops a run.
+//! Needs Blender (3.4: `apt-get install blender python3-numpy`, and `xvfb` for the panel)
+//! and the shipped model: `cargo test --test blender_addon -- --ignored --nocapture`.
 
 use std::process::Command;
 
@@ -36,6 +38,50 @@ fn the_addon_generates_onto_the_active_armature() {
     assert!(
         out.status.success() && report.iter().any(|l| l.contains(": OK")),
         "the add-on test failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+#[ignore = "needs Blender, xvfb-run and the shipped model; run by hand"]
+fn the_panel_runs_in_the_background_and_esc_stops_it() {
+    let have = |tool: &str| {
+        Command::new("sh")
+            .args(["-c", &format!("command -v {tool}")])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !have("blender") || !have("xvfb-run") {
+        println!("SKIPPED: blender or xvfb-run is not installed");
+        return;
+    }
+    let root = env!("CARGO_MANIFEST_DIR");
+    let scripts = tempfile::tempdir().unwrap();
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x720x24"])
+        .args([
+            "blender",
+            "--factory-startup",
+            "--enable-event-simulate",
+            "--python",
+        ])
+        .arg(format!("{root}/integrations/blender/tests/test_panel.py"))
+        .arg("--")
+        .arg(format!("{root}/tests/fixtures/rigs/mixamo_tall.bvh"))
+        .env("MPROG_BIN", env!("CARGO_BIN_EXE_mprog"))
+        .env("BLENDER_USER_SCRIPTS", scripts.path())
+        .current_dir(root)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let report: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("mprog_blender_panel"))
+        .collect();
+    println!("{}", report.join("\n"));
+    assert!(
+        out.status.success() && report.iter().any(|l| l.contains(": OK")),
+        "the panel test failed:\n{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
 }

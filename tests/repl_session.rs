@@ -448,4 +448,38 @@ fn rig_puts_saved_motions_on_a_users_character() {
     );
     let bad = fails(&mut s, ":rig nowhere.bvh");
     assert!(bad.contains("nowhere.bvh"), "{bad}");
+    // A rig whose leg names no table knows, with its mapping file; a skinned .glb.
+    let german = std::fs::read_to_string(rig)
+        .unwrap()
+        .replace("LeftUpLeg", "Oberschenkel_L")
+        .replace("RightUpLeg", "Oberschenkel_R");
+    let (de, map) = (dir.path().join("de rig.bvh"), dir.path().join("map.toml"));
+    std::fs::write(&de, german).unwrap();
+    std::fs::write(
+        &map,
+        "left_hip = \"Oberschenkel_L\"\nright_hip = \"Oberschenkel_R\"\n",
+    )
+    .unwrap();
+    let bad = fails(&mut s, &format!(":rig \"{}\"", de.display()));
+    assert!(bad.contains("left_hip"), "{bad}");
+    let ok = say(
+        &mut s,
+        &format!(":rig \"{}\" {}", de.display(), map.display()),
+    );
+    assert!(ok.contains("and the mapping file"), "{ok}");
+    let glb = rig.replace(".bvh", ".glb");
+    assert!(say(&mut s, &format!(":rig {glb}")).contains(".glb outputs are this file"));
+    let out = dir.path().join("on_rig.glb");
+    say(&mut s, &format!(":save {}", out.display()));
+    let bytes = std::fs::read(&out).unwrap();
+    let names: Vec<String> = mprog::formats::gltf::read::node_positions_at(&bytes, 0)
+        .unwrap()
+        .into_iter()
+        .map(|(n, _)| n)
+        .collect();
+    assert!(
+        names.iter().any(|n| n == "Body"),
+        "the user's mesh node is kept"
+    );
+    assert!(fails(&mut s, ":rig a.bvh b.toml c").contains("optionally its mapping file"));
 }

@@ -631,7 +631,7 @@ fn a_bad_rig_on_the_command_line_writes_nothing() {
         "{err}"
     );
     assert!(!npy.exists() && !bvh.exists(), "nothing written");
-    // A glTF rig is refused with what to do instead.
+    // A broken glTF rig (its header cut short) is refused, saying so; nothing written.
     let glb = dir.path().join("character.glb");
     std::fs::write(&glb, b"glTF").unwrap();
     let out = mprog(&[
@@ -644,9 +644,10 @@ fn a_bad_rig_on_the_command_line_writes_nothing() {
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("must be a .bvh") && err.contains("Blender"),
+        err.contains("cannot read the .glb rig") && err.contains("byte 4"),
         "{err}"
     );
+    assert!(!out.status.success() && !bvh.exists(), "nothing written");
     // --rig needs a .bvh or .glb output, --rig-map needs --rig.
     let out = mprog(&[
         "convert".as_ref(),

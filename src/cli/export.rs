@@ -23,9 +23,11 @@ pub struct ExportArgs {
     #[arg(long, value_enum, value_name = "UNIT", default_value_t)]
     pub bvh_units: UnitsArg,
     /// Put the motion on your character: a BVH of its skeleton (Mixamo, or any rig mprog
-    /// reads). .bvh and .glb outputs take the rig's joints, names, offsets, channels, units
-    /// and axes; joints mprog does not have (fingers, twist bones) keep their rest pose.
-    #[arg(long, value_name = "RIG.bvh")]
+    /// reads) or the character as a skinned .glb. .bvh and .glb outputs take the rig's
+    /// joints, names, offsets, channels, units and axes; joints mprog does not have
+    /// (fingers, twist bones) keep their rest pose. On a .glb rig a .glb output is that
+    /// file, its mesh and skin kept, animated.
+    #[arg(long, value_name = "RIG.bvh|RIG.glb")]
     pub rig: Option<PathBuf>,
     /// Which rig joint is which HumanML3D joint, for names mprog does not recognise: a TOML
     /// file of lines such as `left_knee = "Knee_L"` (`mprog joints` lists the names).

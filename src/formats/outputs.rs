@@ -82,7 +82,7 @@ pub const OUTPUT_KINDS: &[OutputKind] = &[
     },
     OutputKind {
         extensions: &["glb"],
-        what: "glTF 2.0 binary: each person a skinned skeleton (joint nodes at their rest offsets, a skin with inverse bind matrices) with a simple body mesh, animated by rotations and root translation; for three.js, game engines, Blender; with --rig, the rig's skeleton",
+        what: "glTF 2.0 binary: each person a skinned skeleton (joint nodes at their rest offsets, a skin with inverse bind matrices) with a simple body mesh, animated by rotations and root translation; for three.js, game engines, Blender; with --rig, the rig's skeleton; with a .glb rig, that file (its mesh and skin) animated",
         file_per_person: false,
         sidecar: Sidecar::None,
         encode: super::gltf::encode,

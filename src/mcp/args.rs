@@ -23,6 +23,10 @@ pub struct RunArgs {
     pub outputs: Vec<String>,
     /// Also run the unguided sample, for the comparison column.
     pub baseline: bool,
+    /// The user's rig (`.bvh` or skinned `.glb`), a relative path in the output folder.
+    pub rig: Option<String>,
+    /// Its mapping file (TOML), likewise.
+    pub rig_map: Option<String>,
 }
 
 /// Reads a tool call's arguments (absent: an empty object).
@@ -115,7 +119,14 @@ pub fn run(args: &Map<String, Value>) -> Result<RunArgs, String> {
         Some(Value::Bool(b)) => *b,
         Some(other) => return Err(format!("`baseline` must be a boolean, not {}", kind(other))),
     };
+    let rig = string(args, "rig", 1024)?;
+    let rig_map = string(args, "rig_map", 1024)?;
+    if rig_map.is_some() && rig.is_none() {
+        return Err("`rig_map` needs `rig`: the mapping file names the rig's joints".into());
+    }
     Ok(RunArgs {
+        rig,
+        rig_map,
         source: source(args)?,
         solver: string(args, "solver", 64)?.unwrap_or_else(|| "guide".into()),
         seed,
@@ -146,6 +157,14 @@ mod tests {
         .unwrap();
         assert_eq!(a.knobs, [("steps".to_string(), 5.0)]);
         assert_eq!(a.outputs.len(), 2);
+        let a = run(&obj(
+            json!({"source": "x", "rig": "hero.glb", "rig_map": "m.toml"}),
+        ))
+        .unwrap();
+        assert_eq!(
+            (a.rig.as_deref(), a.rig_map.as_deref()),
+            (Some("hero.glb"), Some("m.toml"))
+        );
         for bad in [
             json!({}),
             json!({"source": 3}),
@@ -156,6 +175,8 @@ mod tests {
             json!({"source": "x", "output": []}),
             json!({"source": "x", "output": [1]}),
             json!({"source": "x", "baseline": "no"}),
+            json!({"source": "x", "rig": 3}),
+            json!({"source": "x", "rig_map": "map.toml"}),
         ] {
             assert!(run(&obj(bad.clone())).is_err(), "{bad}");
         }

@@ -65,6 +65,23 @@ impl Runner {
             .collect::<Result<_, _>>()
             .map_err(fail)?;
         crate::formats::check_outputs(&outputs).map_err(|e| fail(e.to_string()))?;
+        // The rig and its map are files the caller put in the output folder; read there only.
+        let rig = args
+            .rig
+            .as_deref()
+            .map(|r| out.for_reading(r))
+            .transpose()
+            .map_err(fail)?;
+        let rig_map = args
+            .rig_map
+            .as_deref()
+            .map(|r| out.for_reading(r))
+            .transpose()
+            .map_err(fail)?;
+        if let Some(r) = &rig {
+            crate::formats::Character::load(r, rig_map.as_deref())
+                .map_err(|e| fail(e.to_string()))?;
+        }
         if let Err(d) = crate::lang::compile(&args.source, SOURCE_NAME, &args.set) {
             return Err(
                 json!({"error": "the program has errors", "file": SOURCE_NAME,
@@ -102,6 +119,12 @@ impl Runner {
         }
         if let Some(m) = &self.model {
             cmd.arg("--model").arg(m);
+        }
+        if let Some(r) = &rig {
+            cmd.arg("--rig").arg(r);
+        }
+        if let Some(m) = &rig_map {
+            cmd.arg("--rig-map").arg(m);
         }
         cmd.arg("-o").args(&outputs);
         if !outputs.contains(&png) {
@@ -209,7 +232,66 @@ mod tests {
             set: vec![],
             outputs: vec!["a.json".into()],
             baseline: false,
+            rig: None,
+            rig_map: None,
         }
+    }
+
+    /// The fake runner with its arguments logged one per line.
+    fn echoing_runner(dir: &std::path::Path) -> PathBuf {
+        let exe = dir.join("echo-mprog");
+        let log = dir.join("args");
+        std::fs::write(
+            &exe,
+            format!(
+                "#!/bin/sh
+for a in \"$@\"; do echo \"$a\" >> {log}; done
+                 while [ $# -gt 0 ]; do if [ \"$1\" = --report ]; then echo '{{\"outputs\": []}}' > \"$2\"; fi; shift; done
+",
+                log = log.display()
+            ),
+        )
+        .unwrap();
+        std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
+        exe
+    }
+
+    #[test]
+    fn a_rig_is_read_inside_the_output_folder_and_checked_before_the_run() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = OutDir::new(&dir.path().join("out")).unwrap();
+        let runner = Runner::new(echoing_runner(dir.path()), None, Duration::from_secs(30));
+        let never = std::future::pending::<()>;
+        let with = |rig: &str| RunArgs {
+            rig: Some(rig.into()),
+            ..args()
+        };
+        let e = block_on(runner.run(&out, with("../hero.bvh"), never()))
+            .err()
+            .unwrap();
+        assert!(
+            e["error"].as_str().unwrap().starts_with("refused path"),
+            "{e}"
+        );
+        let rig = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/fixtures/rigs/mixamo_tall.bvh"
+        );
+        std::fs::copy(rig, out.root().join("hero.bvh")).unwrap();
+        std::fs::write(out.root().join("bad.bvh"), "HIERARCHY\nROOT Hips\n{\n").unwrap();
+        let e = block_on(runner.run(&out, with("bad.bvh"), never()))
+            .err()
+            .unwrap();
+        assert!(e["error"].as_str().unwrap().contains("bad.bvh"), "{e}");
+        assert!(!dir.path().join("args").exists(), "a bad rig was run");
+        block_on(runner.run(&out, with("hero.bvh"), never())).unwrap();
+        let logged = std::fs::read_to_string(dir.path().join("args")).unwrap();
+        let logged: Vec<&str> = logged.lines().collect();
+        let at = logged.iter().position(|a| *a == "--rig").unwrap();
+        assert_eq!(
+            std::path::Path::new(logged[at + 1]),
+            out.root().join("hero.bvh")
+        );
     }
 
     fn block_on<F: Future>(f: F) -> F::Output {

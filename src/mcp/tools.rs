@@ -67,7 +67,9 @@ pub fn tools() -> Vec<Tool> {
                               "description": "solver settings, e.g. {\"steps\": 10}"},
                     "output": {"oneOf": [{"type": "string"}, {"type": "array", "items": {"type": "string"}, "minItems": 1, "maxItems": 16}],
                                "description": "files to write inside the output folder, by relative path; the extension picks the kind (.bvh .npy .json .gif .png .html .glb); default run.json"},
-                    "baseline": {"type": "boolean", "description": "also sample without guidance, for the comparison column (default true)"}}})),
+                    "baseline": {"type": "boolean", "description": "also sample without guidance, for the comparison column (default true)"},
+                    "rig": {"type": "string", "description": "your character, a file you put in the output folder (relative path): a .bvh of its skeleton or a skinned .glb; .bvh and .glb outputs are on it (a .glb output is that file, mesh and all, animated)"},
+                    "rig_map": {"type": "string", "description": "with rig: a TOML file in the output folder naming rig joints mprog does not recognise, lines such as left_knee = \"Knee_L\""}}})),
         ),
         Tool::new(
             "joints",

@@ -43,9 +43,10 @@ pub enum Command {
     /// `:save FILE`: the program (`.mprog`) or the current motion, as any kind of the
     /// output table ([`crate::formats::outputs::OUTPUT_KINDS`]).
     Save(PathBuf),
-    /// `:rig [RIG.bvh | -]`: save `.bvh` / `.glb` motions on this rig (`-`: on the 22-joint
-    /// skeleton again; no argument: say which).
-    Rig(Option<PathBuf>),
+    /// `:rig [RIG [MAP.toml] | -]`: save `.bvh` / `.glb` motions on this rig (a `.bvh` or a
+    /// skinned `.glb`, with a mapping file for joint names mprog does not know; `-`: on the
+    /// 22-joint skeleton again; no argument: say which).
+    Rig(Option<(PathBuf, Option<PathBuf>)>),
     /// `:show`: print the session's program.
     Show,
     /// `:drop N` or `:drop N-M`: delete lines of the session's program (1-based, inclusive).
@@ -152,8 +153,8 @@ pub const COMMANDS: &[CommandDoc] = &[
     doc(
         "rig",
         &[],
-        "[RIG.bvh | -]",
-        "save .bvh and .glb motions on your character's rig (a BVH: Mixamo or any rig mprog reads; --rig-map is for the command line); `-` goes back to the 22-joint skeleton",
+        "[RIG [MAP.toml] | -]",
+        "save .bvh and .glb motions on your character's rig (a .bvh of its skeleton, Mixamo or any rig mprog reads, or a skinned .glb, whose .glb outputs are that file animated; MAP.toml names joints mprog does not recognise, as --rig-map does); `-` goes back to the 22-joint skeleton",
     ),
     doc(
         "show",
@@ -243,9 +244,15 @@ fn parse_args(cmd: &CommandDoc, args: &str) -> Result<Command, String> {
         "render" => need("an output file").map(|a| Command::Render(unquote(&a).into())),
         "view" => need("an output .html file").map(|a| Command::View(unquote(&a).into())),
         "save" => need("a file").map(|a| Command::Save(unquote(&a).into())),
-        "rig" => Ok(Command::Rig(
-            (!args.is_empty()).then(|| unquote(args).into()),
-        )),
+        "rig" => match words(args)?.as_slice() {
+            [] => Ok(Command::Rig(None)),
+            [rig] => Ok(Command::Rig(Some((rig.into(), None)))),
+            [rig, map] => Ok(Command::Rig(Some((rig.into(), Some(map.into()))))),
+            _ => Err(format!(
+                "`:rig` takes a rig file and optionally its mapping file; {}",
+                usage()
+            )),
+        },
         "eval" => need("an expression or a statement").map(Command::Eval),
         "grad" => need("a statement").map(Command::Grad),
         "gen" => parse_gen(args).map_err(|e| format!("{e}; {}", usage())),
@@ -263,6 +270,26 @@ fn parse_args(cmd: &CommandDoc, args: &str) -> Result<Command, String> {
 }
 
 /// A path argument with optional surrounding quotes.
+/// Words of `s`, each bare or in double quotes (for paths with spaces).
+fn words(s: &str) -> Result<Vec<String>, String> {
+    let mut out = Vec::new();
+    let mut rest = s.trim_start();
+    while !rest.is_empty() {
+        if let Some(quoted) = rest.strip_prefix('"') {
+            let end = quoted
+                .find('"')
+                .ok_or("a quote is not closed; write \"my rig.bvh\"")?;
+            out.push(quoted[..end].to_string());
+            rest = quoted[end + 1..].trim_start();
+        } else {
+            let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
+            out.push(rest[..end].to_string());
+            rest = rest[end..].trim_start();
+        }
+    }
+    Ok(out)
+}
+
 fn unquote(s: &str) -> String {
     let s = s.trim();
     s.strip_prefix('"')

@@ -112,7 +112,7 @@ impl Session {
             Command::Score => probe::score(self),
             Command::Render(path) | Command::View(path) => self.export(&path),
             Command::Save(path) => self.save(&path),
-            Command::Rig(path) => self.set_rig(path.as_deref()),
+            Command::Rig(arg) => self.set_rig(arg.as_ref()),
             Command::Show => Reply::text(self.show()),
             Command::Drop { first, last } => self.drop_lines(first, last),
             Command::Clear => {
@@ -505,16 +505,16 @@ impl Session {
         }
     }
 
-    /// `:rig`: shows, sets (`FILE`) or drops (`-`) the rig saved motions go on.
-    fn set_rig(&mut self, path: Option<&Path>) -> Reply {
+    /// `:rig`: shows, sets (`FILE [MAP]`) or drops (`-`) the rig saved motions go on.
+    fn set_rig(&mut self, arg: Option<&(PathBuf, Option<PathBuf>)>) -> Reply {
         const NONE: &str = "no rig: .bvh and .glb motions are saved on the 22-joint skeleton";
-        match path {
+        match arg {
             None => Reply::text(self.rig.as_ref().map_or(NONE.into(), |r| r.summary())),
-            Some(p) if p == Path::new("-") => {
+            Some((p, None)) if p == Path::new("-") => {
                 self.rig = None;
                 Reply::text(NONE)
             }
-            Some(p) => match crate::formats::Character::load(p, None) {
+            Some((p, map)) => match crate::formats::Character::load(p, map.as_deref()) {
                 Ok(rig) => {
                     let summary = rig.summary();
                     self.rig = Some(rig);

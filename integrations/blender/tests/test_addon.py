@@ -123,8 +123,9 @@ def main():
           f"{worst:.1e} m of Blender's own import of the same motion")
 
 
-try:
-    main()
-except Exception as e:
-    print(f"mprog_blender_test: FAIL {type(e).__name__}: {e}")
-    sys.exit(1)
+if __name__ == "__main__":
+    try:
+        main()
+    except Exception as e:
+        print(f"mprog_blender_test: FAIL {type(e).__name__}: {e}")
+        sys.exit(1)

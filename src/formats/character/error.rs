@@ -34,9 +34,11 @@ pub enum RigErrorKind {
     #[error("{0}")]
     Parse(String),
     #[error(
-        "a rig must be a .bvh file (found `.{0}`); export the character's armature as BVH (Blender: File > Export > Motion Capture (.bvh))"
+        "a rig must be a .bvh file or a skinned .glb (found `.{0}`); export the character's armature as BVH (Blender: File > Export > Motion Capture (.bvh)) or the character as glTF Binary (.glb)"
     )]
     NotBvh(String),
+    #[error("cannot read the .glb rig: {0}")]
+    Glb(String),
     #[error("the hierarchy is over {limit} bytes; a character's rig is far smaller")]
     TooLarge { limit: u64 },
     #[error("{}", missing_message(.missing, .mapped_by))]
@@ -140,7 +142,10 @@ fn missing_message(missing: &[Missing], mapped_by: &str) -> String {
             let c: Vec<String> = m
                 .candidates
                 .iter()
-                .map(|(name, line)| format!("`{name}` (line {line})"))
+                .map(|(name, line)| match line {
+                    0 => format!("`{name}`"),
+                    line => format!("`{name}` (line {line})"),
+                })
                 .collect();
             out.push_str(&format!("\n  {}: perhaps {}", m.joint, c.join(" or ")));
         }
@@ -158,11 +163,11 @@ fn missing_message(missing: &[Missing], mapped_by: &str) -> String {
 }
 
 impl RigError {
-    /// An error at a line of `origin`.
+    /// An error at a line of `origin` (line 0: a rig without lines, a `.glb`).
     pub fn at(origin: &str, line: usize, kind: RigErrorKind) -> Self {
         RigError {
             origin: origin.to_string(),
-            line: Some(line),
+            line: (line > 0).then_some(line),
             kind,
         }
     }

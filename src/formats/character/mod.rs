@@ -4,7 +4,7 @@
 //!
 //! | step | module | in → out |
 //! | --- | --- | --- |
-//! | read | [`read`] | a `.bvh` rig (untrusted) → its joints (the MOTION section is ignored) |
+//! | read | [`read`], [`glb`] | a `.bvh` rig (untrusted) → its joints (the MOTION section is ignored); a skinned `.glb` → its skin's joints and the file, to animate |
 //! | mapping file | [`usermap`] | `--rig-map` TOML → (joint, rig joint) entries |
 //! | map | [`map`], [`guess`] | joints + entries → the rig joint of each HumanML3D joint, checked (errors suggest joints by name and by shape) |
 //! | rest pose | here | offsets → rest positions in metres, Y up (units from the leg, up axis from the body) |
@@ -17,6 +17,7 @@
 
 pub mod error;
 pub mod fit;
+pub mod glb;
 pub mod guess;
 pub mod map;
 pub mod plan;
@@ -63,12 +64,22 @@ pub struct Character {
     pub leg: f64,
     /// What drives each joint.
     pub plan: Plan,
+    /// The `.glb` the rig came from: `.glb` outputs animate that file, mesh and all.
+    pub glb: Option<Box<glb::GlbRig>>,
 }
 
 impl Character {
     /// Reads the rig at `path`, with the mapping file `map` if given.
     pub fn load(path: &Path, map: Option<&Path>) -> Result<Character, RigError> {
-        let joints = read::read_rig_file(path)?;
+        let is_glb = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+        let (joints, glb) = if is_glb {
+            let (joints, rig) = glb::read_glb_rig_file(path)?;
+            (joints, Some(Box::new(rig)))
+        } else {
+            (read::read_rig_file(path)?, None)
+        };
         let origin = path.display().to_string();
         let entries = match map {
             Some(m) => {
@@ -79,7 +90,25 @@ impl Character {
             }
             None => Vec::new(),
         };
-        Character::build(&origin, joints, &entries)
+        let mut ch = Character::build(&origin, joints, &entries)?;
+        ch.glb = glb;
+        Ok(ch)
+    }
+
+    /// A rig from `.glb` bytes (and a mapping file's text).
+    pub fn from_glb(
+        origin: &str,
+        bytes: &[u8],
+        map: Option<(&str, &str)>,
+    ) -> Result<Character, RigError> {
+        let (joints, rig) = glb::glb_rig(origin, bytes)?;
+        let entries = match map {
+            Some((map_origin, text)) => usermap::parse_map(map_origin, text, &joints)?,
+            None => Vec::new(),
+        };
+        let mut ch = Character::build(origin, joints, &entries)?;
+        ch.glb = Some(Box::new(rig));
+        Ok(ch)
     }
 
     /// A rig from BVH text (and a mapping file's text): `(origin, text)` pairs.
@@ -158,6 +187,7 @@ impl Character {
             rest,
             leg,
             plan,
+            glb: None,
         })
     }
 
@@ -174,8 +204,13 @@ impl Character {
             UpAxis::Y => "Y up",
             UpAxis::Z => "Z up",
         };
+        let glb = if self.glb.is_some() {
+            "; .glb outputs are this file, its mesh and skin animated"
+        } else {
+            ""
+        };
         format!(
-            "rig {}: {count} joints, {mapped} of the 22 mapped ({}), units {}, {up}, leg {:.3} m; joints it has and mprog does not keep their rest pose",
+            "rig {}: {count} joints, {mapped} of the 22 mapped ({}), units {}, {up}, leg {:.3} m; joints it has and mprog does not keep their rest pose{glb}",
             self.origin, self.mapped_by, self.units, self.leg
         )
     }

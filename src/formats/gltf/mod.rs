@@ -8,7 +8,8 @@
 //!   direction × the motion's mean bone length) from its parent, with the zero-offset
 //!   connectors where bones branch; or, with `--rig`, the user's rig ([`super::character`]):
 //!   its joints, names and rest offsets (End Sites are drawn, not nodes). Every joint node's
-//!   rest rotation is the identity: the bind pose is the skeleton's rest pose.
+//!   rest rotation is the identity: the bind pose is the skeleton's rest pose. A rig read
+//!   from a skinned `.glb` is written as that file animated instead ([`onto_rig`]).
 //! * Skin: one per person: its joint nodes and inverse bind matrices (the inverse of each
 //!   joint's rest transform, a translation).
 //! * Body: one mesh per person ([`body`]): a capped prism per bone, each vertex bound with
@@ -22,6 +23,7 @@
 
 pub mod body;
 pub mod document;
+pub mod onto_rig;
 pub mod read;
 #[cfg(test)]
 mod tests;
@@ -59,7 +61,11 @@ pub fn encode(origin: &str, job: &OutputJob) -> Result<Vec<u8>, String> {
                 .map_err(|e| format!("{origin}: cannot export as glTF: {e}")),
         })
         .collect::<Result<Vec<Posed>, String>>()?;
-    posed_glb(&people).map_err(|e| format!("{origin}: cannot export as glTF: {e}"))
+    let written = match job.rig.and_then(|r| r.glb.as_deref().map(|g| (r, g))) {
+        Some((rig, glb)) => onto_rig::onto_rig_glb(rig, glb, &people),
+        None => posed_glb(&people),
+    };
+    written.map_err(|e| format!("{origin}: cannot export as glTF: {e}"))
 }
 
 /// The `.glb` file of `people` (one skeleton each, on the 22-joint export rig).

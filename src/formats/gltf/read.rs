@@ -1,7 +1,9 @@
-//! Reading back the `.glb` files mprog writes, for tests and checks: the chunks, the
-//! accessors' data, and forward kinematics of the node tree at an animation key, with or
-//! without skinning the body mesh. Not a general glTF reader: it knows the layout
-//! [`super::posed_glb`] writes (one buffer, float or unsigned data, LINEAR keys per frame).
+//! Reading `.glb` files. [`chunks`] splits any `.glb` (untrusted: every length checked;
+//! a rig is read through it). The rest is for tests and checks: the files mprog writes,
+//! their accessors' data and the forward kinematics of the node tree at an animation key,
+//! with or without skinning the body mesh ([`parse_glb`] knows the layout
+//! [`super::posed_glb`] writes: one buffer, float or unsigned data, LINEAR keys per frame),
+//! and [`node_positions_at`] for any file mprog animated.
 
 use super::document::{Document, FLOAT, UNSIGNED_INT, UNSIGNED_SHORT};
 use super::{CHUNK_BIN, CHUNK_JSON, GLB_MAGIC};
@@ -13,34 +15,56 @@ pub struct Glb {
     pub bin: Vec<u8>,
 }
 
-/// Parses a `.glb` written by mprog.
-pub fn parse_glb(bytes: &[u8]) -> Result<Glb, String> {
+/// The JSON chunk and the binary chunk, if any.
+pub fn chunks(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), String> {
     let word = |at: usize| -> Result<u32, String> {
         bytes
             .get(at..at + 4)
-            .map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes")))
-            .ok_or_else(|| format!("truncated at byte {at}"))
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| format!("the file ends at byte {} inside a header", bytes.len()))
     };
-    if (word(0)?, word(4)?) != (GLB_MAGIC, 2) {
-        return Err("not a glTF 2 binary".into());
+    if word(0)? != GLB_MAGIC {
+        return Err(
+            "not a glTF binary (.glb): the file does not start with `glTF`; a .gltf with separate files cannot be a rig, export as glTF Binary".into(),
+        );
+    }
+    if word(4)? != 2 {
+        return Err(format!("glTF binary version {}, not 2", word(4)?));
     }
     if word(8)? as usize != bytes.len() {
-        return Err("the header's length is not the file's".into());
+        return Err(format!(
+            "the header gives a length of {} bytes but the file has {}",
+            word(8)?,
+            bytes.len()
+        ));
     }
-    let json_len = word(12)? as usize;
-    if word(16)? != CHUNK_JSON {
-        return Err("the first chunk is not JSON".into());
+    let mut at = 12;
+    let mut found: Vec<(u32, &[u8])> = Vec::new();
+    while at < bytes.len() {
+        let len = word(at)? as usize;
+        let kind = word(at + 4)?;
+        let data = bytes
+            .get(at + 8..at + 8 + len)
+            .ok_or_else(|| format!("the chunk at byte {at} runs past the end of the file"))?;
+        found.push((kind, data));
+        at += 8 + len;
     }
-    let json = bytes.get(20..20 + json_len).ok_or("truncated JSON chunk")?;
-    let bin_at = 20 + json_len;
-    let bin_len = word(bin_at)? as usize;
-    if word(bin_at + 4)? != CHUNK_BIN || bin_at + 8 + bin_len != bytes.len() {
-        return Err("the binary chunk does not end the file".into());
+    match found.as_slice() {
+        [(CHUNK_JSON, json), rest @ ..] => {
+            let bin = rest.first().filter(|(k, _)| *k == CHUNK_BIN).map(|c| c.1);
+            Ok((json, bin))
+        }
+        _ => Err("the first chunk is not the JSON chunk".into()),
     }
+}
+
+/// Parses a `.glb` written by mprog.
+pub fn parse_glb(bytes: &[u8]) -> Result<Glb, String> {
+    let (json, bin) = chunks(bytes)?;
     let doc: Document = serde_json::from_slice(json).map_err(|e| e.to_string())?;
     Ok(Glb {
         doc,
-        bin: bytes[bin_at + 8..].to_vec(),
+        bin: bin.ok_or("no binary chunk")?.to_vec(),
     })
 }
 
@@ -173,4 +197,78 @@ impl Glb {
             .map(|(p, j)| mats[j[0] as usize].transform_point3(Vec3::from_slice(p)))
             .collect())
     }
+}
+
+/// Name and world position of every node of any `.glb` (a user's character animated by
+/// mprog, say) at key `key` of its first animation (one key per frame, float data, packed
+/// views); nodes a cycle hides are an error.
+pub fn node_positions_at(bytes: &[u8], key: usize) -> Result<Vec<(String, glam::DVec3)>, String> {
+    use crate::formats::character::glb;
+    use serde_json::Value;
+    let (json, bin) = chunks(bytes)?;
+    let json: Value = serde_json::from_slice(json).map_err(|e| e.to_string())?;
+    let bin = bin.unwrap_or_default();
+    let list = |v: &Value, k: &str| -> Vec<Value> {
+        v.get(k)
+            .and_then(Value::as_array)
+            .cloned()
+            .unwrap_or_default()
+    };
+    let nodes = list(&json, "nodes");
+    let mut local = nodes
+        .iter()
+        .map(glb::local)
+        .collect::<Result<Vec<_>, String>>()?;
+    let (views, accessors) = (list(&json, "bufferViews"), list(&json, "accessors"));
+    let num = |v: &Value, k: &str| v.get(k).and_then(Value::as_u64).unwrap_or(0) as usize;
+    let floats = |a: usize, width: usize| -> Result<Vec<f64>, String> {
+        let acc = accessors.get(a).ok_or("no such accessor")?;
+        let view = views.get(num(acc, "bufferView")).ok_or("no such view")?;
+        let start = num(view, "byteOffset") + num(acc, "byteOffset") + key * width * 4;
+        let b = bin
+            .get(start..start + width * 4)
+            .ok_or_else(|| format!("accessor {a} has no key {key}"))?;
+        Ok(b.chunks_exact(4)
+            .map(|c| f64::from(f32::from_le_bytes([c[0], c[1], c[2], c[3]])))
+            .collect())
+    };
+    if let Some(anim) = list(&json, "animations").first() {
+        let samplers = list(anim, "samplers");
+        for ch in list(anim, "channels") {
+            let sampler = samplers.get(num(&ch, "sampler")).ok_or("no such sampler")?;
+            let target = ch.get("target").ok_or("a channel without a target")?;
+            let node = local.get_mut(num(target, "node")).ok_or("no such node")?;
+            let output = num(sampler, "output");
+            match target.get("path").and_then(Value::as_str) {
+                Some("rotation") => {
+                    let q = floats(output, 4)?;
+                    node.rotation = glam::DQuat::from_xyzw(q[0], q[1], q[2], q[3]).normalize();
+                }
+                Some("translation") => {
+                    node.translation = glam::DVec3::from_slice(&floats(output, 3)?);
+                }
+                Some("scale") => node.scale = glam::DVec3::from_slice(&floats(output, 3)?),
+                other => return Err(format!("unexpected animated path {other:?}")),
+            }
+        }
+    }
+    let parent = glb::parents(&json, nodes.len())?;
+    let order = glb::preorder(&json, &parent)?;
+    let mut world = vec![None::<glb::World>; nodes.len()];
+    for &i in &order {
+        let above = parent[i].map_or(glb::World::ORIGIN, |p| world[p].expect("parents first"));
+        world[i] = Some(above.child(&local[i]));
+    }
+    Ok(nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| {
+            let name = n
+                .get("name")
+                .and_then(Value::as_str)
+                .unwrap_or("")
+                .to_string();
+            (name, world[i].expect("every node").position)
+        })
+        .collect())
 }
