@@ -190,6 +190,45 @@ fn untouched_time_is_held_unless_free_time() {
     assert_eq!(meta["edit"]["held_time"], serde_json::json!([[0, 5]]));
 }
 
+/// A take longer than the model makes (15 s) is edited in windows: the time the program
+/// does not read stays the take's.
+#[test]
+fn a_take_longer_than_the_model_is_edited_in_windows() {
+    let dir = tempfile::tempdir().unwrap();
+    let prog = program(dir.path(), WALK);
+    let (take_path, people) = take(dir.path(), "long.json", 300, 1);
+    let want = &Take::encode(&people).unwrap().motions().unwrap()[0];
+    let out_path = dir.path().join("out.json");
+    let out = run(&[
+        "run",
+        &prog,
+        "--from",
+        &take_path,
+        "--knob",
+        "steps=10",
+        "--knob",
+        "k_late=20",
+        "--knob",
+        "late_steps=2",
+        "--no-baseline",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("in 2 windows"), "{err}");
+    // WALK reads 50%..100% of 299 frames: 0..139 are held, 139..149 ease in.
+    assert!(
+        err.contains("untouched time held to the take: frames 0..139"),
+        "{err}"
+    );
+    let (got, _) = people_of(&out_path);
+    assert_eq!(got[0].len(), 299);
+    let first = |m: &Motion| Motion::new(m.frames[..139].to_vec());
+    let gap = max_joint_error(&first(&got[0]), &first(want));
+    assert!(gap < 0.02, "untouched time moved {gap} m");
+}
+
 #[test]
 fn bad_takes_windows_and_strengths_are_clear_errors_with_no_output() {
     let dir = tempfile::tempdir().unwrap();
@@ -205,6 +244,7 @@ fn bad_takes_windows_and_strengths_are_clear_errors_with_no_output() {
     };
     let (one, _) = take(dir.path(), "one.json", 41, 1);
     let (long, _) = take(dir.path(), "long.json", 300, 1);
+    let (too_long, _) = take(dir.path(), "too_long.json", 4002, 1);
     let missing = dir.path().join("missing.bvh").display().to_string();
     let garbage = dir.path().join("garbage.bvh");
     std::fs::write(&garbage, "not a bvh").unwrap();
@@ -232,7 +272,14 @@ fn bad_takes_windows_and_strengths_are_clear_errors_with_no_output() {
             vec![&prog, "--from", &one, "--edit", "10..41"],
             "outside the take",
         ),
-        (vec![&prog, "--from", &long], "gives 299 frames"),
+        (
+            vec![&prog, "--from", &too_long],
+            "gives 4001 frames; a motion is at",
+        ),
+        (
+            vec![&prog, "--from", &long, "--to", &one, "--context", "20"],
+            "in-between",
+        ),
         (
             vec![&prog, "--from", &long, "--take-frames", "250..400"],
             "outside the take",

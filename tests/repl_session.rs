@@ -2,6 +2,8 @@
 //! checked against numbers computed by hand on a synthetic motion, and against
 //! `lang::check_source` for diagnostics.
 
+mod common;
+
 use burn::tensor::{Device, Tensor, TensorData};
 use glam::Vec3;
 use mprog::lang::{check_source, compile};
@@ -375,6 +377,33 @@ fn save_writes_the_program_and_the_motion_with_its_scores() {
     );
     assert!(txt.contains(".bvh") && txt.contains(".mprog"), "{txt}");
     assert!(fails(&mut Session::new(None), ":save p.mprog").contains("empty"));
+}
+
+/// A take longer than the model makes (12 s) is edited in windows, as `mprog run` does.
+#[test]
+fn run_edits_a_long_take_in_windows() {
+    let dir = tempfile::tempdir().unwrap();
+    let take = dir.path().join("long.json");
+    let long = common::synthetic_walk(241);
+    mprog::formats::write_motion(
+        &take,
+        std::slice::from_ref(&long),
+        &mprog::formats::Meta::new(),
+    )
+    .unwrap();
+    let mut s = Session::new(Some(mprog::model::weights::default_model_dir()));
+    say(&mut s, "prompt \"a person walks forward\"");
+    say(&mut s, "length 12s");
+    say(&mut s, "at end { head.y > 1 m }");
+    say(&mut s, &format!(":motion {}", take.display()));
+    let out = say(
+        &mut s,
+        ":run guide 2 steps=10 k_late=20 late_steps=2 strength=0.5",
+    );
+    assert!(
+        out.contains("at strength 0.5") && out.contains("240 frames"),
+        "{out}"
+    );
 }
 
 #[test]

@@ -13,7 +13,7 @@ use mprog::model::ModelBundle;
 use mprog::model::control::ControlNet;
 use mprog::model::weights::default_model_dir;
 use mprog::motion::Motion;
-use mprog::solve::long::{LongProgress, LongRequest, PromptSpan, solve_long};
+use mprog::solve::long::{LongProgress, LongRequest, LongTake, PromptSpan, solve_long};
 use mprog::solve::{Prior, Progress, SolveRequest, SolveResult, Solver, solve};
 use std::path::PathBuf;
 
@@ -151,10 +151,12 @@ fn timelines_of(program: &Program, prompts: &[String], frames: usize) -> Vec<Vec
                     prompt: prompt.clone(),
                 }]
             } else {
+                // A span to the program's end runs to the motion's (a take's length wins).
+                let end = program.length();
                 line.into_iter()
                     .map(|t| PromptSpan {
                         from: t.from,
-                        to: t.to,
+                        to: if t.to >= end { t.to.max(frames) } else { t.to },
                         prompt: t.text,
                     })
                     .collect()
@@ -182,11 +184,21 @@ fn facing_people(program: &Program, prompts: &[String], free: bool) -> Vec<(bool
 
 /// Solves `req` with a progress bar; with `timelines`, window by window
 /// ([`mprog::solve::long`]), the request giving the length, seed, solver and placements.
+/// How a motion made in windows is made: the timelines, the context kept, resampling
+/// rounds, and the take edited, if any.
+#[derive(Clone, Copy)]
+struct Windowed<'a> {
+    timelines: &'a [Vec<PromptSpan>],
+    context: usize,
+    resample: usize,
+    take: Option<&'a LongTake>,
+}
+
 fn solve_with_bar(
     bundle: &ModelBundle,
     control: Option<&ControlNet>,
     req: &SolveRequest,
-    timelines: Option<(&[Vec<PromptSpan>], usize, usize)>,
+    timelines: Option<Windowed>,
     error: &dyn mprog::solve::MotionError,
     device: &Device,
     label: &str,
@@ -207,11 +219,17 @@ fn solve_with_bar(
                 bar.set_message(format!("error {e:.4}"));
             }
         }),
-        Some((lines, context, resample)) => {
+        Some(Windowed {
+            timelines: lines,
+            context,
+            resample,
+            take,
+        }) => {
             let long = LongRequest {
                 timelines: lines.to_vec(),
                 context,
                 resample,
+                take: take.cloned(),
                 placements: req.placements.clone(),
                 guidance_scale: req.guidance_scale,
                 // Windows are not cleaned: each window's cleanup, with no polish after it,
@@ -297,17 +315,35 @@ pub fn run(mut args: RunArgs) -> Result<()> {
     // Longer than the model makes, or prompts on a timeline: made in windows.
     let timelines = timelines_of(&program, &prompts, frames);
     let windowed = frames > bundle.config.max_frames || timelines.iter().any(|t| t.len() > 1);
-    if windowed && edit.is_some() {
-        return Err(miette!(
-            help = format!(
-                "edit a take of at most {:.1} s with a single prompt",
-                bundle.config.max_frames as f32 / 20.0
-            ),
-            "editing a take in windows (a take longer than the model makes, or a prompt timeline) is not supported"
-        ));
-    }
+    // A take longer than the model makes, or edited under a timeline: each window edits
+    // its stretch of it (an in-between's gap is no take to stretch).
+    let long_take = match (&edit, &plan) {
+        (Some(_), Some(p)) if windowed && p.after.is_some() => {
+            return Err(miette!(
+                help = format!(
+                    "in-between takes whose gap and ends fit in {:.1} s, with a single prompt",
+                    bundle.config.max_frames as f32 / 20.0
+                ),
+                "an in-between in windows (longer than the model makes, or a prompt timeline) is not supported"
+            ));
+        }
+        (Some(e), Some(p)) if windowed => Some(LongTake {
+            people: p.people.clone(),
+            strength: e.strength,
+            hold: e.hold.clone(),
+            hold_path: e.hold_path,
+            hold_joints: e.hold_joints,
+            resample: e.resample,
+        }),
+        _ => None,
+    };
     let context = super::generate::seam_context_frames(args.seam_context)?;
-    let windows = windowed.then_some((timelines.as_slice(), context, args.seam_resample));
+    let windows = windowed.then_some(Windowed {
+        timelines: &timelines,
+        context,
+        resample: args.seam_resample,
+        take: long_take.as_ref(),
+    });
     let window_plan = if windowed {
         let w =
             mprog::solve::long::plan_windows(&timelines, frames, bundle.config.max_frames, context)

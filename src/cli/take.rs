@@ -266,14 +266,18 @@ pub fn plan(args: &TakeArgs, program: &Program, max_frames: usize) -> Result<Opt
         );
     }
     let frames = people[0].len() - 1;
-    if frames > max_frames {
+    // Longer than the model makes: edited in windows (`solve::long`), up to a program's
+    // longest motion.
+    let longest = mprog::lang::check::MAX_LENGTH;
+    if frames > longest {
         return Err(miette!(
             help = format!(
                 "pick a part with --take-frames a..b (at most {} frames)",
-                max_frames + 1
+                longest + 1
             ),
-            "the take {} gives {frames} frames; this model edits at most {max_frames}",
-            from.display()
+            "the take {} gives {frames} frames; a motion is at most {longest} ({} s)",
+            from.display(),
+            longest / 20
         ));
     }
     let keep = match (&args.edit, args.keep.as_slice()) {

@@ -402,20 +402,37 @@ impl Session {
                     .collect(),
             })
             .collect();
+        // A long take is edited window by window, as `mprog run` edits it.
+        let long_take =
+            req.edit
+                .as_ref()
+                .zip(self.take.as_ref())
+                .map(|(e, t)| crate::solve::long::LongTake {
+                    people: t
+                        .people
+                        .iter()
+                        .map(|m| Motion {
+                            frames: m.frames[..=frames.min(m.len() - 1)].to_vec(),
+                            fps: m.fps,
+                        })
+                        .collect(),
+                    strength: e.strength,
+                    hold: e.hold.clone(),
+                    hold_path: e.hold_path,
+                    hold_joints: e.hold_joints,
+                    resample: e.resample,
+                });
         let result = match self.bundle() {
             Err(e) => return Reply::error(e),
             Ok(bundle) => {
                 let prior = Prior::from_bundle(bundle);
                 let windowed = frames > prior.max_frames || timelines.iter().any(|t| t.len() > 1);
                 match (windowed, &req.edit) {
-                    (true, Some(_)) => {
-                        return Reply::error(
-                            "editing a take in windows (longer than the model makes, or a prompt timeline) is not supported",
-                        );
-                    }
-                    (true, None) => {
+                    (true, edit) => {
+                        let take = edit.as_ref().and(long_take);
                         let long = crate::solve::long::LongRequest {
                             timelines,
+                            take,
                             placements: req.placements.clone(),
                             ..crate::solve::long::LongRequest::new(
                                 Vec::new(),

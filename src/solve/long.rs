@@ -58,6 +58,27 @@ pub const PROMPT_BLEND: usize = 20;
 /// 0.097 inside the windows (the book's timeline page).
 pub const SEAM_BLEND: usize = 20;
 
+/// A take a long request edits (`mprog run --from` with a take longer than the model
+/// makes, or with a prompt timeline): each window edits its stretch of the take, the frames
+/// kept from the window before in front of it, with the whole edit's holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LongTake {
+    /// Per person, the take's world joints: the request's frames + 1 (F joint frames give
+    /// F − 1 feature rows).
+    pub people: Vec<Motion>,
+    /// How far into each window's chain the take is noised ([`Edit::strength`]).
+    pub strength: f32,
+    /// Per frame of the whole motion, how firmly it is held to the take (empty: none), as
+    /// [`Edit::hold`]: untouched time at 1.
+    pub hold: Vec<f32>,
+    /// [`Edit::hold_path`].
+    pub hold_path: bool,
+    /// [`Edit::hold_joints`].
+    pub hold_joints: [bool; NUM_JOINTS],
+    /// [`Edit::resample`], of every window.
+    pub resample: usize,
+}
+
 /// One prompt of a person's timeline: frames `[from, to)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PromptSpan {
@@ -94,6 +115,8 @@ pub struct LongRequest {
     /// RePaint resampling rounds of every window after the first ([`Edit::resample`]);
     /// each round adds about the chain's length again.
     pub resample: usize,
+    /// The take edited, if any: each window then edits its stretch of it.
+    pub take: Option<LongTake>,
 }
 
 impl LongRequest {
@@ -119,6 +142,7 @@ impl LongRequest {
             context: DEFAULT_CONTEXT,
             clean_feet: false,
             resample: DEFAULT_WINDOW_RESAMPLE,
+            take: None,
         }
     }
 
@@ -409,6 +433,17 @@ pub fn solve_long(
         ));
     }
     let people = req.timelines.len();
+    if let Some(t) = &req.take {
+        let fits = t.people.len() == people
+            && t.people.iter().all(|m| m.len() == req.frames + 1)
+            && (t.hold.is_empty() || t.hold.len() == req.frames);
+        if !fits {
+            return Err(SolveError::Invalid(format!(
+                "the take to edit must have {people} people of {} frames (and a hold per frame)",
+                req.frames + 1
+            )));
+        }
+    }
     let mut motions = Vec::with_capacity(req.samples);
     let mut features = Vec::new();
     let mut placements = Vec::with_capacity(req.samples);
@@ -432,10 +467,12 @@ pub fn solve_long(
                 start: win.start,
                 frames: req.frames,
             };
-            let edit = window_edit(req, win, &made, prior.mean, w == 0)?;
-            let held = edit
-                .as_ref()
-                .map_or(0, |e| e.hold.iter().take_while(|h| **h >= 1.0).count());
+            let edit = match &req.take {
+                Some(take) => Some(take_edit(req, take, win, &made)?),
+                None => window_edit(req, win, &made, prior.mean, w == 0)?,
+            };
+            // The frames kept from the window before, cross-faded when stitched.
+            let held = win.hold.iter().take_while(|h| **h >= 1.0).count();
             let mut sreq = SolveRequest::new(
                 win.prompts.clone(),
                 win.len(),
@@ -561,6 +598,53 @@ fn window_edit(
         resample: req.resample,
         clean_feet: req.clean_feet,
     }))
+}
+
+/// The edit of window `win` of a long take: the frames kept from the motion so far, then
+/// the take's own frames, held as the window's blend and the whole edit's holds say
+/// (whichever holds more), noised as far as the edit's strength.
+fn take_edit(
+    req: &LongRequest,
+    take: &LongTake,
+    win: &Window,
+    made: &[Motion],
+) -> Result<Edit, SolveError> {
+    let n = win.len();
+    let have = made[0].len().clamp(win.start, win.end);
+    let parts: Vec<Motion> = made
+        .iter()
+        .zip(&take.people)
+        .map(|(m, t)| Motion {
+            frames: [&m.frames[win.start..have], &t.frames[have..=win.end]].concat(),
+            fps: t.fps,
+        })
+        .collect();
+    let encoded = Take::encode(&parts).map_err(|e| {
+        SolveError::Invalid(format!(
+            "cannot encode the take's frames {}..{}: {e}",
+            win.start, win.end
+        ))
+    })?;
+    let hold: Vec<f32> = (0..n)
+        .map(|j| {
+            let edit = take.hold.get(win.start + j).copied().unwrap_or(0.0);
+            win.hold[j].max(edit)
+        })
+        .collect();
+    let hold = if hold.iter().all(|h| *h == 0.0) {
+        Vec::new()
+    } else {
+        hold
+    };
+    Ok(Edit {
+        take: encoded,
+        strength: take.strength,
+        hold,
+        hold_path: take.hold_path,
+        hold_joints: take.hold_joints,
+        resample: take.resample,
+        clean_feet: req.clean_feet,
+    })
 }
 
 /// Puts a window's motion into the motion so far: cross-faded over the frames it kept
@@ -785,6 +869,73 @@ mod tests {
             seam <= 2.0 * inside + 1e-3,
             "seam step {seam} vs inside {inside}"
         );
+    }
+
+    /// A take longer than the model makes, edited in windows: the time the edit holds stays
+    /// the take's, the keyframe in the last window is met.
+    #[test]
+    fn a_long_take_is_edited_in_windows_keeping_its_untouched_time() {
+        let bundle = tiny_bundle();
+        let prior = Prior::from_bundle(&bundle);
+        // A rest pose walking 4 cm a frame, arms swinging, 90 frames.
+        let walk = Motion::new(
+            (0..90)
+                .map(|t| {
+                    let mut p = crate::skeleton::rest_pose();
+                    let swing = 0.15 * (t as f32 * 0.4).sin();
+                    p[20].z += swing;
+                    p[21].z -= swing;
+                    p.map(|v| v + glam::Vec3::new(0.5, 0.0, 0.04 * t as f32))
+                })
+                .collect(),
+        );
+        let take = vec![walk];
+        // What the take is on the model's skeleton (an edit keeps that).
+        let want = Take::encode(&take).unwrap().motions().unwrap().remove(0);
+        let solver = Solver::new(GuideConfig {
+            steps: 40,
+            k_late: 30,
+            late_steps: 5,
+            ..GuideConfig::default()
+        });
+        let mut req = LongRequest::new(vec!["a person walks forward".into()], 89, 3, solver);
+        req.context = 10;
+        // Frames 0..50 untouched, eased out over 5 frames; the rest free.
+        let mut hold = vec![0.0; 89];
+        hold[..50].fill(1.0);
+        for (j, h) in hold[50..55].iter_mut().enumerate() {
+            *h = fade_out(j, 5);
+        }
+        req.take = Some(LongTake {
+            people: take.clone(),
+            strength: 0.7,
+            hold,
+            hold_path: false,
+            hold_joints: [false; NUM_JOINTS],
+            resample: 0,
+        });
+        let error = WristUpAt(80);
+        let mut windows = 0;
+        let out = solve_long(&prior, &req, &error, &Device::flex(), |p| {
+            windows = p.windows
+        })
+        .unwrap();
+        assert!(windows > 2, "{windows} windows");
+        let m = &out.motions[0][0];
+        assert_eq!(m.len(), 89);
+        assert!(out.error[0] < 0.05, "the keyframe is met: {:?}", out.error);
+        let worst = (0..45)
+            .flat_map(|t| (0..NUM_JOINTS).map(move |j| (t, j)))
+            .map(|(t, j)| m.frames[t][j].distance(want.frames[t][j]))
+            .fold(0.0, f32::max);
+        assert!(worst < 0.02, "untouched time moved {worst} m");
+        let moved = m.frames[80][21].distance(want.frames[80][21]);
+        println!("untouched time within {worst} m; frame 80's wrist moved {moved} m");
+        assert!(moved > 0.05, "the edited time is edited ({moved} m)");
+        // A take that does not fit the request is refused.
+        req.frames = 60;
+        let e = solve_long(&prior, &req, &error, &Device::flex(), |_| {}).unwrap_err();
+        assert!(e.to_string().contains("the take to edit"), "{e}");
     }
 
     #[test]
