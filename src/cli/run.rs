@@ -232,8 +232,10 @@ fn solve_with_bar(
                 take: take.cloned(),
                 placements: req.placements.clone(),
                 guidance_scale: req.guidance_scale,
-                // Windows are not cleaned: each window's cleanup, with no polish after it,
-                // left a timeline's `at 11s` statement 2 cm short.
+                // Each window's feet are cleaned as `gen` cleans them (`--raw`: not); `guide`
+                // polishes the window's statements after its cleanup, which a cleanup
+                // without a polish left 2 cm short (a timeline's `at 11s`).
+                clean_feet: req.clean_feet,
                 ..LongRequest::new(Vec::new(), req.frames, req.seed, req.solver.clone())
             };
             solve_long(&prior, &long, error, device, |p: LongProgress| {
