@@ -453,3 +453,64 @@ fn blender_reads_the_animated_character() {
     println!("{line}");
     assert!(out.status.success() && line.contains(": OK"), "{stdout}");
 }
+
+/// three.js (GLTFLoader, AnimationMixer, in Node) plays the animated character and the
+/// plain `.glb` with their joints where mprog put them:
+/// `npm install --prefix DIR three@0.187.0`, then
+/// `THREE_MODULES=DIR/node_modules cargo test --test retarget_glb -- --ignored --nocapture three`.
+#[test]
+#[ignore = "needs Node and three.js (THREE_MODULES); run by hand"]
+fn three_js_plays_the_animated_character_and_the_plain_glb() {
+    let Some(modules) = std::env::var_os("THREE_MODULES") else {
+        println!("SKIPPED: set THREE_MODULES to a node_modules folder holding three");
+        return;
+    };
+    let (expected, out) = both(&glb_bytes(), 1);
+    let (_, clip) = common::golden();
+    let dir = tempfile::tempdir().unwrap();
+    let track = |frames: &[[DVec3; 22]]| {
+        Motion::from_flat(
+            &frames
+                .iter()
+                .flat_map(|f| f.iter().flat_map(|p| p.as_vec3().to_array()))
+                .collect::<Vec<f32>>(),
+        )
+    };
+    let plain = mprog::formats::gltf::glb_bytes(std::slice::from_ref(&clip)).unwrap();
+    let mixamo: Vec<String> = MIXAMO.iter().map(|m| format!("mixamorig:{m}")).collect();
+    let cases = [
+        ("rig", out, track(&expected), mixamo.join(",")),
+        (
+            "plain",
+            plain,
+            clip.clone(),
+            mprog::skeleton::JOINT_NAMES.join(","),
+        ),
+    ];
+    for (name, glb, motion, names) in cases {
+        let (file, npy) = (
+            dir.path().join(format!("{name}.glb")),
+            dir.path().join(format!("{name}.npy")),
+        );
+        std::fs::write(&file, glb).unwrap();
+        mprog::formats::npy::write_joints_npy(&npy, &[motion]).unwrap();
+        let run = Command::new("node")
+            .arg(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/scripts/three_gltf_check.mjs"
+            ))
+            .arg(&file)
+            .arg(&npy)
+            .arg(&names)
+            .env("THREE_MODULES", &modules)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&run.stdout);
+        println!("{name}: {}", stdout.trim());
+        assert!(
+            run.status.success() && stdout.contains(": OK"),
+            "{stdout}{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+}

@@ -282,7 +282,9 @@ fn finish(
     }
     match &ctx.edit {
         Some(edit) => {
-            edit.clean_free_feet(&mut features, ctx.frames);
+            if !out.cleaned {
+                edit.clean_free_feet(&mut features, ctx.frames);
+            }
             edit.rebuild_seams(&mut features, ctx.frames);
         }
         None if ctx.clean_feet && !out.cleaned => {

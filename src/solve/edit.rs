@@ -441,11 +441,16 @@ impl EditState {
 }
 
 impl EditState {
+    /// Whether [`Self::clean_free_feet`] does anything.
+    pub fn cleans_feet(&self) -> bool {
+        self.clean_feet && self.strength != 0.0
+    }
+
     /// The edit's foot cleanup on the denormalised `[B·P, N, 263]` result (`frames` per
     /// motion), when it asks for one: what is held (kept frames, held columns) is put
     /// back afterwards, so only what the model made is touched.
     pub fn clean_free_feet(&self, features: &mut [f32], frames: usize) {
-        if !self.clean_feet || self.strength == 0.0 {
+        if !self.cleans_feet() {
             return;
         }
         let before = features.to_vec();

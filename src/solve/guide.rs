@@ -389,7 +389,9 @@ fn run(
         });
     }
     let mut x = host(ctx.hold_final(x));
-    let cleaned = ctx.clean_feet && cfg.fused.is_some();
+    // An edit cleans only what it does not hold, and is polished the same way.
+    let asks = ctx.clean_feet || ctx.edit.as_ref().is_some_and(|e| e.cleans_feet());
+    let cleaned = asks && cfg.fused.is_some();
     if let Some(fused) = cfg.fused.as_ref().filter(|_| cleaned) {
         let values = clean_and_polish(ctx, cfg, fused, &schedule, &mut objective, &mut x)?;
         trace.push(values);
@@ -422,7 +424,12 @@ fn clean_and_polish(
 ) -> Result<Vec<f32>, SolveError> {
     let (mean, std) = (ctx.prior.mean, ctx.prior.std);
     denormalize_slice(x, mean, std).map_err(|e| SolveError::Invalid(e.to_string()))?;
-    clean_feet(x, ctx.frames, FEATURE_DIM, &FootCleanup::default());
+    match &ctx.edit {
+        Some(edit) => edit.clean_free_feet(x, ctx.frames),
+        None => {
+            clean_feet(x, ctx.frames, FEATURE_DIM, &FootCleanup::default());
+        }
+    }
     normalize_slice(x, mean, std).map_err(|e| SolveError::Invalid(e.to_string()))?;
     let step = (cfg.tau as f64 * cfg.sigma_hat(schedule.posterior(0).variance_clipped)) as f32;
     let inner = Inner {
