@@ -45,6 +45,8 @@ pub struct Ctx<'a> {
     /// Clean the result's feet ([`super::cleanup`]): asked for and not an edit (an edit
     /// cleans by its own settings).
     pub clean_feet: bool,
+    /// An edit's cleanup is the solver's, with its polish ([`SolveRequest::polish_edit`]).
+    pub polish_edit: bool,
 }
 
 /// What a solver hands back: normalised samples and, when it relaxes, a transform per motion.
@@ -257,6 +259,7 @@ pub fn solve(
             .as_ref()
             .map(|e| EditState::new(e, req.samples, prior.mean, prior.std, device)),
         clean_feet: req.clean_feet && req.edit.is_none(),
+        polish_edit: req.polish_edit,
     };
     let progress: &mut dyn FnMut(Progress) = &mut on_progress;
     let out = req.solver.run(&ctx, progress)?;

@@ -389,8 +389,9 @@ fn run(
         });
     }
     let mut x = host(ctx.hold_final(x));
-    // An edit cleans only what it does not hold, and is polished the same way.
-    let asks = ctx.clean_feet || ctx.edit.as_ref().is_some_and(|e| e.cleans_feet());
+    // A window's edit cleans only what it does not hold, and is polished the same way.
+    let asks = ctx.clean_feet
+        || (ctx.polish_edit && ctx.edit.as_ref().is_some_and(|e| e.cleans_feet()));
     let cleaned = asks && cfg.fused.is_some();
     if let Some(fused) = cfg.fused.as_ref().filter(|_| cleaned) {
         let values = clean_and_polish(ctx, cfg, fused, &schedule, &mut objective, &mut x)?;

@@ -481,6 +481,7 @@ pub fn solve_long(
             );
             sreq.guidance_scale = req.guidance_scale;
             sreq.placements = req.placements.clone();
+            sreq.polish_edit = true;
             if let Some(e) = edit {
                 sreq = sreq.editing(e);
             }

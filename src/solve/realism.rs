@@ -219,6 +219,7 @@ mod tests {
             decoder: Decoder::new(&bundle.mean, &bundle.std, &[Placement::IDENTITY]),
             edit: None,
             clean_feet: false,
+            polish_edit: false,
         };
         let before = ctx.initial_noise();
         let after: Vec<f32> = before.iter().map(|v| v * 0.5 + 0.1).collect();
