@@ -10,18 +10,13 @@
 
 use std::process::Command;
 
-#[test]
-#[ignore = "needs Blender and the shipped model; run by hand"]
-fn the_addon_generates_onto_the_active_armature() {
-    if Command::new("blender").arg("--version").output().is_err() {
-        println!("SKIPPED: blender is not installed");
-        return;
-    }
+/// Runs an add-on test script with `launcher` (Blender, or Blender under `xvfb-run`) on
+/// the test rig, prints its report lines (those starting with `tag`) and asserts an OK.
+fn run_script(mut launcher: Command, script: &str, tag: &str) {
     let root = env!("CARGO_MANIFEST_DIR");
     let scripts = tempfile::tempdir().unwrap();
-    let out = Command::new("blender")
-        .args(["-b", "--factory-startup", "--python"])
-        .arg(format!("{root}/integrations/blender/tests/test_addon.py"))
+    let out = launcher
+        .arg(format!("{root}/integrations/blender/tests/{script}"))
         .arg("--")
         .arg(format!("{root}/tests/fixtures/rigs/mixamo_tall.bvh"))
         .env("MPROG_BIN", env!("CARGO_BIN_EXE_mprog"))
@@ -30,58 +25,48 @@ fn the_addon_generates_onto_the_active_armature() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let report: Vec<&str> = stdout
-        .lines()
-        .filter(|l| l.starts_with("mprog_blender_test"))
-        .collect();
+    let report: Vec<&str> = stdout.lines().filter(|l| l.starts_with(tag)).collect();
     println!("{}", report.join("\n"));
     assert!(
         out.status.success() && report.iter().any(|l| l.contains(": OK")),
-        "the add-on test failed:\n{stdout}\n{}",
+        "{script} failed:\n{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// Whether `tool` is on PATH.
+fn have(tool: &str) -> bool {
+    Command::new("sh")
+        .args(["-c", &format!("command -v {tool}")])
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+#[test]
+#[ignore = "needs Blender and the shipped model; run by hand"]
+fn the_addon_generates_onto_the_active_armature() {
+    if !have("blender") {
+        println!("SKIPPED: blender is not installed");
+        return;
+    }
+    let mut blender = Command::new("blender");
+    blender.args(["-b", "--factory-startup", "--python"]);
+    run_script(blender, "test_addon.py", "mprog_blender_test");
 }
 
 #[test]
 #[ignore = "needs Blender, xvfb-run and the shipped model; run by hand"]
 fn the_panel_runs_in_the_background_and_esc_stops_it() {
-    let have = |tool: &str| {
-        Command::new("sh")
-            .args(["-c", &format!("command -v {tool}")])
-            .output()
-            .is_ok_and(|o| o.status.success())
-    };
     if !have("blender") || !have("xvfb-run") {
         println!("SKIPPED: blender or xvfb-run is not installed");
         return;
     }
-    let root = env!("CARGO_MANIFEST_DIR");
-    let scripts = tempfile::tempdir().unwrap();
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1280x720x24"])
-        .args([
-            "blender",
-            "--factory-startup",
-            "--enable-event-simulate",
-            "--python",
-        ])
-        .arg(format!("{root}/integrations/blender/tests/test_panel.py"))
-        .arg("--")
-        .arg(format!("{root}/tests/fixtures/rigs/mixamo_tall.bvh"))
-        .env("MPROG_BIN", env!("CARGO_BIN_EXE_mprog"))
-        .env("BLENDER_USER_SCRIPTS", scripts.path())
-        .current_dir(root)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let report: Vec<&str> = stdout
-        .lines()
-        .filter(|l| l.starts_with("mprog_blender_panel"))
-        .collect();
-    println!("{}", report.join("\n"));
-    assert!(
-        out.status.success() && report.iter().any(|l| l.contains(": OK")),
-        "the panel test failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let mut xvfb = Command::new("xvfb-run");
+    xvfb.args(["-a", "-s", "-screen 0 1280x720x24"]).args([
+        "blender",
+        "--factory-startup",
+        "--enable-event-simulate",
+        "--python",
+    ]);
+    run_script(xvfb, "test_panel.py", "mprog_blender_panel");
 }

@@ -13,7 +13,7 @@ use mprog::model::ModelBundle;
 use mprog::model::control::ControlNet;
 use mprog::model::weights::default_model_dir;
 use mprog::motion::Motion;
-use mprog::solve::long::{LongProgress, LongRequest, LongTake, PromptSpan, solve_long};
+use mprog::solve::long::{LongProgress, LongRequest, LongTake, PromptSpan, solve_long, timelines};
 use mprog::solve::{Prior, Progress, SolveRequest, SolveResult, Solver, solve};
 use std::path::PathBuf;
 
@@ -136,33 +136,14 @@ fn per_statement(program: &Program, people: &[Motion], device: &Device) -> Resul
         .map_err(|e| miette!("{e:?}"))
 }
 
-/// Each person's timeline for a request: the program's spans, or the one prompt (the
-/// program's or `--text`) over the whole motion.
+/// Each person's timeline (see [`timelines`]).
 fn timelines_of(program: &Program, prompts: &[String], frames: usize) -> Vec<Vec<PromptSpan>> {
-    program
+    let spans = program
         .timelines()
         .into_iter()
-        .zip(prompts)
-        .map(|(line, prompt)| {
-            if line.is_empty() {
-                vec![PromptSpan {
-                    from: 0,
-                    to: frames,
-                    prompt: prompt.clone(),
-                }]
-            } else {
-                // A span to the program's end runs to the motion's (a take's length wins).
-                let end = program.length();
-                line.into_iter()
-                    .map(|t| PromptSpan {
-                        from: t.from,
-                        to: if t.to >= end { t.to.max(frames) } else { t.to },
-                        prompt: t.text,
-                    })
-                    .collect()
-            }
-        })
-        .collect()
+        .map(|line| line.into_iter().map(|t| (t.from, t.to, t.text)).collect())
+        .collect();
+    timelines(spans, prompts, frames, program.length())
 }
 
 /// Per person: whether the solver steers them to face along their path and keeps them
@@ -329,14 +310,7 @@ pub fn run(mut args: RunArgs) -> Result<()> {
                 "an in-between in windows (longer than the model makes, or a prompt timeline) is not supported"
             ));
         }
-        (Some(e), Some(p)) if windowed => Some(LongTake {
-            people: p.people.clone(),
-            strength: e.strength,
-            hold: e.hold.clone(),
-            hold_path: e.hold_path,
-            hold_joints: e.hold_joints,
-            resample: e.resample,
-        }),
+        (Some(e), Some(p)) if windowed => Some(LongTake::of(e, p.people.clone())),
         _ => None,
     };
     let context = super::generate::seam_context_frames(args.seam_context)?;

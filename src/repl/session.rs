@@ -382,46 +382,25 @@ impl Session {
         let along = crate::solve::facing::FacingAlongPath::steered(&program, &steering);
         let error: &dyn crate::solve::MotionError = &along;
         // Longer than the model makes, or prompts on a timeline: window by window.
-        let timelines: Vec<Vec<crate::solve::long::PromptSpan>> = program
+        let spans = program
             .timelines()
             .into_iter()
-            .zip(&req.prompts)
-            .map(|(line, prompt)| match line.is_empty() {
-                true => vec![crate::solve::long::PromptSpan {
-                    from: 0,
-                    to: frames,
-                    prompt: prompt.clone(),
-                }],
-                false => line
-                    .into_iter()
-                    .map(|t| crate::solve::long::PromptSpan {
-                        from: t.from,
-                        to: t.to,
-                        prompt: t.text,
-                    })
-                    .collect(),
-            })
+            .map(|line| line.into_iter().map(|t| (t.from, t.to, t.text)).collect())
             .collect();
+        let timelines =
+            crate::solve::long::timelines(spans, &req.prompts, frames, program.length());
         // A long take is edited window by window, as `mprog run` edits it.
-        let long_take =
-            req.edit
-                .as_ref()
-                .zip(self.take.as_ref())
-                .map(|(e, t)| crate::solve::long::LongTake {
-                    people: t
-                        .people
-                        .iter()
-                        .map(|m| Motion {
-                            frames: m.frames[..=frames.min(m.len() - 1)].to_vec(),
-                            fps: m.fps,
-                        })
-                        .collect(),
-                    strength: e.strength,
-                    hold: e.hold.clone(),
-                    hold_path: e.hold_path,
-                    hold_joints: e.hold_joints,
-                    resample: e.resample,
-                });
+        let long_take = req.edit.as_ref().zip(self.take.as_ref()).map(|(e, t)| {
+            let people = t
+                .people
+                .iter()
+                .map(|m| Motion {
+                    frames: m.frames[..=frames.min(m.len() - 1)].to_vec(),
+                    fps: m.fps,
+                })
+                .collect();
+            crate::solve::long::LongTake::of(e, people)
+        });
         let result = match self.bundle() {
             Err(e) => return Reply::error(e),
             Ok(bundle) => {

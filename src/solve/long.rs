@@ -79,6 +79,21 @@ pub struct LongTake {
     pub resample: usize,
 }
 
+impl LongTake {
+    /// The long take of `edit` (its strength and holds), on the take's world joints
+    /// `people`.
+    pub fn of(edit: &Edit, people: Vec<Motion>) -> LongTake {
+        LongTake {
+            people,
+            strength: edit.strength,
+            hold: edit.hold.clone(),
+            hold_path: edit.hold_path,
+            hold_joints: edit.hold_joints,
+            resample: edit.resample,
+        }
+    }
+}
+
 /// One prompt of a person's timeline: frames `[from, to)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PromptSpan {
@@ -88,6 +103,38 @@ pub struct PromptSpan {
     pub to: usize,
     /// What the person does.
     pub prompt: String,
+}
+
+/// Each person's timeline for a motion of `frames`: the program's spans `(from, to,
+/// prompt)` as written, a span to the program's `end` running on to `frames` (a take's
+/// length wins over the program's); a person without spans has one prompt, `prompts[p]`,
+/// for the whole motion.
+pub fn timelines(
+    spans: Vec<Vec<(usize, usize, String)>>,
+    prompts: &[String],
+    frames: usize,
+    end: usize,
+) -> Vec<Vec<PromptSpan>> {
+    spans
+        .into_iter()
+        .zip(prompts)
+        .map(|(line, prompt)| {
+            if line.is_empty() {
+                return vec![PromptSpan {
+                    from: 0,
+                    to: frames,
+                    prompt: prompt.clone(),
+                }];
+            }
+            line.into_iter()
+                .map(|(from, to, prompt)| PromptSpan {
+                    from,
+                    to: if to >= end { to.max(frames) } else { to },
+                    prompt,
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// A long motion or a timeline to solve.

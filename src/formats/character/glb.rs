@@ -142,11 +142,8 @@ pub fn glb_rig(origin: &str, bytes: &[u8]) -> Result<(Vec<BvhJoint>, GlbRig), Ri
     let order = preorder(&json, &parent).map_err(fail)?;
     let skin = skin_joints(&json, nodes.len()).map_err(fail)?;
 
-    let mut world = vec![World::ORIGIN; nodes.len()];
-    for &i in &order {
-        let above = parent[i].map_or(World::ORIGIN, |p| world[p]);
-        world[i] = above.child(&nodes[i].local);
-    }
+    let locals: Vec<Local> = nodes.iter().map(|n| n.local).collect();
+    let world = worlds(&locals, &parent, &order);
     let mut is_joint = vec![false; nodes.len()];
     for &n in &skin {
         is_joint[n] = true;
@@ -257,14 +254,28 @@ fn nodes(json: &Value) -> Result<Vec<NodeRead>, String> {
         .iter()
         .enumerate()
         .map(|(i, n)| {
-            let name = n
-                .get("name")
-                .and_then(Value::as_str)
-                .map_or_else(|| format!("node{i}"), str::to_string);
+            let name = node_name(n, i);
             let local = local(n).map_err(|e| format!("node {i} (`{name}`): {e}"))?;
             Ok(NodeRead { name, local })
         })
         .collect()
+}
+
+/// A node's name (`node{i}` when it has none).
+pub fn node_name(node: &Value, i: usize) -> String {
+    node.get("name")
+        .and_then(Value::as_str)
+        .map_or_else(|| format!("node{i}"), str::to_string)
+}
+
+/// Every node's world transform from its `local` one, visiting `order` (parents first).
+pub fn worlds(local: &[Local], parent: &[Option<usize>], order: &[usize]) -> Vec<World> {
+    let mut world = vec![World::ORIGIN; local.len()];
+    for &i in order {
+        let above = parent[i].map_or(World::ORIGIN, |p| world[p]);
+        world[i] = above.child(&local[i]);
+    }
+    world
 }
 
 /// A node's `matrix`, or its `translation`, `rotation` and `scale`.

@@ -267,10 +267,7 @@ fn copy_scene(
             continue;
         }
         let mut copy = nodes[i].clone();
-        let name = copy
-            .get("name")
-            .and_then(Value::as_str)
-            .map_or_else(|| format!("node{i}"), str::to_string);
+        let name = glb::node_name(&copy, i);
         copy["name"] = json!(format!("{prefix}{name}"));
         if let Some(children) = copy.get("children").and_then(Value::as_array) {
             let moved: Vec<usize> = children

@@ -254,21 +254,13 @@ pub fn node_positions_at(bytes: &[u8], key: usize) -> Result<Vec<(String, glam::
     }
     let parent = glb::parents(&json, nodes.len())?;
     let order = glb::preorder(&json, &parent)?;
-    let mut world = vec![None::<glb::World>; nodes.len()];
-    for &i in &order {
-        let above = parent[i].map_or(glb::World::ORIGIN, |p| world[p].expect("parents first"));
-        world[i] = Some(above.child(&local[i]));
-    }
+    let world = glb::worlds(&local, &parent, &order);
     Ok(nodes
         .iter()
         .enumerate()
         .map(|(i, n)| {
-            let name = n
-                .get("name")
-                .and_then(Value::as_str)
-                .unwrap_or("")
-                .to_string();
-            (name, world[i].expect("every node").position)
+            let name = n.get("name").and_then(Value::as_str).unwrap_or("");
+            (name.to_string(), world[i].position)
         })
         .collect())
 }
