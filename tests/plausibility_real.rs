@@ -14,7 +14,7 @@
 use mprog::dataset::DatasetIndex;
 use mprog::dataset::envelope::Envelope;
 use mprog::dataset::store::read_f32_npy;
-use mprog::metrics::plausibility::{Kind, check};
+use mprog::metrics::plausibility::{ACCEL_MARGIN, Kind, check};
 use mprog::motion::Motion;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -24,6 +24,23 @@ fn data_dir() -> PathBuf {
         || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/combined"),
         PathBuf::from,
     )
+}
+
+/// The solver's late steps hold each joint's acceleration under what the report flags
+/// in the shipped model's envelope, so a motion inside the guard is not reported.
+#[test]
+fn the_guards_limits_sit_inside_what_the_shipped_report_flags() {
+    let env = Envelope::load(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/default/envelope.json"),
+    )
+    .unwrap();
+    for (j, limit) in mprog::solve::envelope::ACCEL_LIMITS.iter().enumerate() {
+        let flagged = ACCEL_MARGIN * env.accel_peak[j].p99;
+        assert!(
+            *limit < flagged,
+            "joint {j}: {limit} ≥ the report's {flagged}"
+        );
+    }
 }
 
 #[test]

@@ -294,7 +294,7 @@ fn commands_report_usage() {
     // The solvers and their knobs come from the registry.
     let run = say(&mut s, ":help run");
     assert!(
-        run.contains("lbfgs:") && run.contains("k_late=500"),
+        run.contains("lbfgs:") && run.contains("paper=0") && run.contains("k_late=200"),
         "{run}"
     );
     assert!(s.handle(":quit").quit);

@@ -21,14 +21,16 @@
 //!   smooth the step over frames ([`GuideConfig::smooth_frames`]), give each statement its
 //!   own Polyak step ([`FusedSettings::split_terms`]) and scale the root columns down
 //!   ([`FusedSettings::late_root_scale`], `late_root`);
-//! * frame 0 is not frozen ([`GuideConfig::freeze_first_frame`], `freeze`).
+//! * frame 0 is not frozen ([`GuideConfig::freeze_first_frame`], `freeze`);
+//! * the registered solver (`run`, the REPL, MCP) runs a short chain chosen by measurement,
+//!   [`GuideConfig::measured`]; `paper=1` gives OmniControl's schedule back.
 //!
 //! The denoiser is not in the inner loop: only FK, the error and its gradient are, through
 //! the fused host path ([`super::host`]) by default. Where the reference code and the paper
 //! differ, and the step-size rule ([`StepRule::Polyak`] by default): the book's "`guide`:
 //! paper, code, and the step size".
 
-use super::knobs::{Knob, knob};
+use super::knobs::{Knob, KnobKind, knob};
 use super::solver::{Solver, SolverConfig, SolverSpec};
 use crate::model::sampler::SamplerKind;
 use super::SolveError;
@@ -181,6 +183,9 @@ pub struct FusedSettings {
     /// does not make is met by walking the people into each other. Small values make the
     /// late steps meet it with the pose instead (see the module notes). Default 0.01.
     pub late_root_scale: f32,
+    /// Iterations of the program's error after the foot cleanup ([`clean_and_polish`]).
+    /// Default [`POLISH_ITERATIONS`].
+    pub polish_iterations: usize,
 }
 
 impl FusedSettings {
@@ -193,6 +198,7 @@ impl FusedSettings {
         early_root_only: false,
         split_terms: false,
         late_root_scale: 1.0,
+        polish_iterations: POLISH_ITERATIONS,
     };
 
     fn check_settings(&self) -> Result<(), SolveError> {
@@ -230,6 +236,7 @@ impl Default for FusedSettings {
             early_root_only: true,
             split_terms: true,
             late_root_scale: 0.01,
+            polish_iterations: POLISH_ITERATIONS,
         }
     }
 }
@@ -256,7 +263,61 @@ impl Default for GuideConfig {
     }
 }
 
+/// The chain's length and effort: what `paper=1` switches between.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct ChainSchedule {
+    steps: usize,
+    k_late: usize,
+    late_steps: usize,
+    polish_iterations: usize,
+}
+
+/// OmniControl's: 1000 DDPM steps, K = 500 on the last 10.
+const PAPER_SCHEDULE: ChainSchedule = ChainSchedule {
+    steps: DIFFUSION_STEPS,
+    k_late: 500,
+    late_steps: 10,
+    polish_iterations: POLISH_ITERATIONS,
+};
+
+/// `run`'s, by measurement (the book's benchmarks, "`run`'s chain"): 100 respaced steps,
+/// K = 200 on the last 5 and a 300-iteration polish meet and look as the paper schedule
+/// does on the sentence bench and the cookbook, 6–10 times faster. Fewer late iterations
+/// (K = 50) left five cookbook programs millimetres short of met.
+const MEASURED_SCHEDULE: ChainSchedule = ChainSchedule {
+    steps: 100,
+    k_late: 200,
+    late_steps: 5,
+    polish_iterations: 300,
+};
+
 impl GuideConfig {
+    /// The default settings on [`MEASURED_SCHEDULE`]'s chain: what the registered solver
+    /// (`run`, the REPL, MCP) uses.
+    pub fn measured() -> Self {
+        let mut cfg = GuideConfig::default();
+        cfg.set_schedule(MEASURED_SCHEDULE);
+        cfg
+    }
+
+    fn schedule(&self) -> ChainSchedule {
+        ChainSchedule {
+            steps: self.steps,
+            k_late: self.k_late,
+            late_steps: self.late_steps,
+            polish_iterations: self.fused.map_or(POLISH_ITERATIONS, |f| f.polish_iterations),
+        }
+    }
+
+    fn set_schedule(&mut self, s: ChainSchedule) {
+        self.steps = s.steps;
+        self.k_late = s.k_late;
+        self.late_steps = s.late_steps;
+        if let Some(fused) = self.fused.as_mut() {
+            fused.polish_iterations = s.polish_iterations;
+        }
+    }
+
     pub(crate) fn check_settings(&self) -> Result<(), SolveError> {
         if !(1..=DIFFUSION_STEPS).contains(&self.steps) {
             return Err(SolveError::Invalid(format!(
@@ -405,11 +466,12 @@ fn run(
     })
 }
 
-/// Iterations of the program's error after the foot cleanup ([`clean_and_polish`]).
+/// Iterations of the program's error after the foot cleanup ([`clean_and_polish`]), by
+/// default.
 pub const POLISH_ITERATIONS: usize = 100;
 
 /// The foot cleanup `gen` gives its samples ([`super::cleanup`]), then
-/// [`POLISH_ITERATIONS`] iterations of the last step's inner loop with the feet as the
+/// `polish_iterations` iterations of the last step's inner loop with the feet as the
 /// cleanup planted them locked. The cleanup stands every planted foot still, which moves
 /// the body by millimetres (the projection rests it on its lowest foot): cleaned and not
 /// polished, statements met to 1e-4 came back at 0.001–0.003 (a facing keyframe, a
@@ -435,7 +497,7 @@ fn clean_and_polish(
     let step = (cfg.tau as f64 * cfg.sigma_hat(schedule.posterior(0).variance_clipped)) as f32;
     let inner = Inner {
         fix_envelope: true,
-        ..Inner::at(cfg, fused, 0, POLISH_ITERATIONS, step)
+        ..Inner::at(cfg, fused, 0, fused.polish_iterations, step)
     };
     let at = |it: usize| format!("the polish after the foot cleanup (iteration {})", it + 1);
     guide_fused(ctx, cfg, objective, x, inner, 0, &at)
@@ -825,7 +887,7 @@ pub fn smooth_over_frames(v: &[f32], frames: usize, width: usize, sigma: f32) ->
 pub const SPECS: &[SolverSpec] = &[SolverSpec {
     name: "guide",
     summary: "the posterior mean μ_t, K gradient steps at every DDPM step (OmniControl)",
-    make: || Solver::new(GuideConfig::default()),
+    make: || Solver::new(GuideConfig::measured()),
 }];
 
 /// A knob on a field of [`FusedSettings`]. On the graph path (`fused: None`, made only in
@@ -848,6 +910,18 @@ macro_rules! fused_knob {
 
 impl SolverConfig for GuideConfig {
     const KNOBS: &'static [Knob<Self>] = &[
+        Knob {
+            name: "paper",
+            doc: "1: OmniControl's schedule (1000 DDPM steps, k_late 500 on the last 10, polish 100); 0: the measured short chain (100 steps, k_late 200 on the last 5, polish 300). Knobs after it change single settings",
+            kind: KnobKind::Flag {
+                off: "the measured short chain",
+                on: "OmniControl's schedule",
+            },
+            get: |c: &GuideConfig| f64::from(u8::from(c.schedule() == PAPER_SCHEDULE)),
+            set: |c: &mut GuideConfig, v| {
+                c.set_schedule(if v != 0.0 { PAPER_SCHEDULE } else { MEASURED_SCHEDULE })
+            },
+        },
         knob!(Count, "steps", "DDPM steps (fewer = respaced chain, faster, rougher)", steps),
         knob!(Count, "k_early", "gradient iterations per step before the last `late_steps`", k_early),
         knob!(Count, "k_late", "gradient iterations per step during the last `late_steps`", k_late),
@@ -905,6 +979,7 @@ impl SolverConfig for GuideConfig {
             "1: the ControlNet runs once per step, on the text-conditioned half of classifier-free guidance, and steers both halves (half its cost); 0: a pass per half, as OmniControl",
             realism_shared
         ),
+        fused_knob!(Count, "polish", "iterations of the program's error after the foot cleanup, feet locked where the cleanup planted them", polish_iterations),
         fused_knob!(Real, "late_root", "share of the root columns (path) in each step of the last `late_steps`, 0–1: the late steps meet contacts and keyframes with the pose instead of by moving the people; 1: OmniControl's plain gradient", late_root_scale),
     ];
 

@@ -791,6 +791,35 @@ fn knobs_set_settings_and_unknown_ones_list_the_valid_names() {
     assert_eq!(ik.name(), "ik-reg");
 }
 
+#[test]
+fn paper_switches_guides_chain_and_later_knobs_still_apply() {
+    let mut guide = Solver::by_name("guide").unwrap();
+    assert_eq!(
+        guide.config::<GuideConfig>(),
+        Some(&GuideConfig::measured())
+    );
+    assert_eq!(guide.unguided(), Solver::plain(SamplerKind::Ddpm(100)));
+    guide.set_knob("paper", 1.0).unwrap();
+    assert_eq!(guide.config::<GuideConfig>(), Some(&GuideConfig::default()));
+    assert_eq!(guide.unguided(), Solver::plain(SamplerKind::Ddpm(1000)));
+    guide.set_knob("k_late", 300.0).unwrap();
+    let c = guide.config::<GuideConfig>().unwrap();
+    assert_eq!((c.steps, c.k_late, c.late_steps), (1000, 300, 10));
+    let paper = |s: &Solver| {
+        s.knobs()
+            .iter()
+            .find(|k| k.name == "paper")
+            .map(|k| k.value)
+    };
+    assert_eq!(paper(&guide), Some(0.0), "no longer the paper's schedule");
+    guide.set_knob("paper", 0.0).unwrap();
+    assert_eq!(
+        guide.config::<GuideConfig>(),
+        Some(&GuideConfig::measured())
+    );
+    assert!(guide.set_knob("paper", 2.0).is_err());
+}
+
 /// Largest bone-length error of the first motion against the skeleton.
 fn worst_bone(r: &SolveResult) -> f32 {
     use crate::skeleton::{BONE_LENGTHS, NUM_JOINTS, PARENTS};

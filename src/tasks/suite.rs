@@ -255,9 +255,7 @@ pub enum SolverSettings {
 /// runs with its defaults.
 pub const FAST_KNOBS: &[(&str, &str, f64)] = &[
     ("plain", "steps", 100.0),
-    ("guide", "steps", 100.0),
-    ("guide", "k_late", 50.0),
-    ("guide", "late_steps", 5.0),
+    // `guide` runs its default, the measured short chain (`paper=0`).
     // 60 iterations, the cookbook's: with step 8,704, 30 left Fig. 1 0.105 off and 60
     // 0.0004 (the solvers chapter); at 10, step 6,550 left HSC-1 0.11 off (task notes).
     ("latent", "ddim_steps", 10.0),
@@ -274,18 +272,23 @@ pub const FAST_KNOBS: &[(&str, &str, f64)] = &[
     ("lbfgs", "steps", 100.0),
 ];
 
+/// Knobs of the papers' settings where a solver's default is not the paper's.
+pub const PAPER_KNOBS: &[(&str, &str, f64)] = &[("guide", "paper", 1.0)];
+
 /// Every registered solver, with the benchmark's settings.
 pub fn solvers(settings: SolverSettings) -> Vec<Solver> {
     crate::solve::registry()
         .iter()
         .map(|spec| {
             let mut solver = (spec.make)();
-            if settings == SolverSettings::Fast {
-                for (_, knob, value) in FAST_KNOBS.iter().filter(|k| k.0 == spec.name) {
-                    solver
-                        .set_knob(knob, *value)
-                        .expect("FAST_KNOBS names knobs the solver has");
-                }
+            let knobs = match settings {
+                SolverSettings::Fast => FAST_KNOBS,
+                SolverSettings::Paper => PAPER_KNOBS,
+            };
+            for (_, knob, value) in knobs.iter().filter(|k| k.0 == spec.name) {
+                solver
+                    .set_knob(knob, *value)
+                    .expect("FAST_KNOBS and PAPER_KNOBS name knobs the solver has");
             }
             solver
         })
@@ -300,22 +303,32 @@ mod fast_settings_tests {
     #[test]
     fn fast_settings_cover_registered_solvers_and_shorten_their_chains() {
         let names = Solver::names();
-        for (solver, _, _) in FAST_KNOBS {
+        for (solver, _, _) in FAST_KNOBS.iter().chain(PAPER_KNOBS) {
             assert!(
                 names.contains(solver),
-                "FAST_KNOBS names unknown `{solver}`"
+                "FAST_KNOBS or PAPER_KNOBS names unknown `{solver}`"
             );
         }
         let fast = solvers(SolverSettings::Fast);
         assert_eq!(fast.len(), names.len());
         let guide = fast[0].config::<GuideConfig>().unwrap();
-        assert_eq!((guide.steps, guide.k_late, guide.late_steps), (100, 50, 5));
+        assert_eq!(*guide, GuideConfig::measured());
+        assert_eq!((guide.steps, guide.k_late, guide.late_steps), (100, 200, 5));
         let ik_reg = fast.iter().find(|s| s.name() == "ik-reg").unwrap();
         let c = ik_reg.config::<IkConfig>().unwrap();
         assert_eq!((c.iterations, c.lr, c.smoothness), (100, 0.05, 0.1));
+        let paper = solvers(SolverSettings::Paper);
         assert_eq!(
-            solvers(SolverSettings::Paper)[0],
-            Solver::by_name("guide").unwrap()
+            paper[0].config::<GuideConfig>(),
+            Some(&GuideConfig::default())
         );
+        let flag = |s: &Solver| {
+            s.knobs()
+                .iter()
+                .find(|k| k.name == "paper")
+                .map(|k| k.value)
+        };
+        assert_eq!(flag(&paper[0]), Some(1.0));
+        assert_eq!(flag(&fast[0]), Some(0.0));
     }
 }
