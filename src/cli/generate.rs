@@ -154,6 +154,11 @@ fn generate_long(
         clean_feet: !args.raw,
         context: seam_context_frames(args.seam_context)?,
         resample: args.seam_resample,
+        action_frames: mprog::solve::long::action_frames(
+            &bundle.text,
+            &one_prompt(&args.text, frames),
+            bundle.config.max_frames,
+        ),
         ..LongRequest::new(
             vec![args.text.clone()],
             frames,
@@ -189,6 +194,15 @@ fn generate_long(
         features: out.features,
         unknown_words: out.unknown_words,
     })
+}
+
+/// `gen`'s timeline: one person, one prompt over the whole motion.
+fn one_prompt(text: &str, frames: usize) -> Vec<Vec<mprog::solve::long::PromptSpan>> {
+    vec![vec![mprog::solve::long::PromptSpan {
+        from: 0,
+        to: frames,
+        prompt: text.to_string(),
+    }]]
 }
 
 /// Runs `mprog gen`.
@@ -299,15 +313,13 @@ pub fn run(mut args: GenArgs) -> Result<()> {
     meta.insert("guidance_scale".into(), (args.guidance as f64).into());
     meta.insert("foot_cleanup".into(), (!args.raw).into());
     if long {
+        let line = one_prompt(&args.text, frames);
         let windows = mprog::solve::long::plan_windows(
-            &[vec![mprog::solve::long::PromptSpan {
-                from: 0,
-                to: frames,
-                prompt: args.text.clone(),
-            }]],
+            &line,
             frames,
             bundle.config.max_frames,
             seam_context_frames(args.seam_context)?,
+            &mprog::solve::long::action_frames(&bundle.text, &line, bundle.config.max_frames),
         )
         .into_diagnostic()?;
         meta.insert("windows".into(), windows_meta(&windows));

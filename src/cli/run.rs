@@ -175,6 +175,19 @@ struct Windowed<'a> {
     take: Option<&'a LongTake>,
 }
 
+/// The actions' own lengths the windows are cut to ([`mprog::solve::long::action_frames`]);
+/// none when a take is edited (its windows follow the take).
+fn window_actions(
+    bundle: &ModelBundle,
+    timelines: &[Vec<PromptSpan>],
+    editing: bool,
+) -> Vec<(String, usize)> {
+    if editing {
+        return Vec::new();
+    }
+    mprog::solve::long::action_frames(&bundle.text, timelines, bundle.config.max_frames)
+}
+
 fn solve_with_bar(
     bundle: &ModelBundle,
     control: Option<&ControlNet>,
@@ -217,6 +230,7 @@ fn solve_with_bar(
                 // polishes the window's statements after its cleanup, which a cleanup
                 // without a polish left 2 cm short (a timeline's `at 11s`).
                 clean_feet: req.clean_feet,
+                action_frames: window_actions(bundle, lines, take.is_some()),
                 ..LongRequest::new(Vec::new(), req.frames, req.seed, req.solver.clone())
             };
             solve_long(&prior, &long, error, device, |p: LongProgress| {
@@ -321,9 +335,14 @@ pub fn run(mut args: RunArgs) -> Result<()> {
         take: long_take.as_ref(),
     });
     let window_plan = if windowed {
-        let w =
-            mprog::solve::long::plan_windows(&timelines, frames, bundle.config.max_frames, context)
-                .into_diagnostic()?;
+        let w = mprog::solve::long::plan_windows(
+            &timelines,
+            frames,
+            bundle.config.max_frames,
+            context,
+            &window_actions(&bundle, &timelines, long_take.is_some()),
+        )
+        .into_diagnostic()?;
         eprintln!(
             "{:.1} s in {} windows of at most {:.1} s, each keeping {:.1} s of the one before",
             frames as f32 / 20.0,

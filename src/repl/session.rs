@@ -409,9 +409,19 @@ impl Session {
                 match (windowed, &req.edit) {
                     (true, edit) => {
                         let take = edit.as_ref().and(long_take);
+                        // Actions at their own length, except where a take is edited.
+                        let action_frames = match take {
+                            Some(_) => Vec::new(),
+                            None => crate::solve::long::action_frames(
+                                prior.text,
+                                &timelines,
+                                prior.max_frames,
+                            ),
+                        };
                         let long = crate::solve::long::LongRequest {
                             timelines,
                             take,
+                            action_frames,
                             placements: req.placements.clone(),
                             ..crate::solve::long::LongRequest::new(
                                 Vec::new(),

@@ -7,6 +7,11 @@
 //!   from the motion made so far: they are a take ([`Take::encode`] of the world joints,
 //!   so the window stands where the motion is) held by MDM-style in-painting
 //!   ([`super::edit`]), and the model continues them under the window's own prompt.
+//! * **Actions at their own length.** A prompt whose training clips are shorter than the
+//!   model's length ([`LongRequest::action_frames`], the bundle's median clip length of the
+//!   nearest caption) gets windows of at most that many new frames: "a person runs
+//!   forward" is a run at its clips' 3.1 s (2.7 m/s) and a jog in one 7 s window
+//!   (1.3–1.5 m/s), so a 6 s run span is made as two runs of 3 s.
 //! * **Blends.** Each window runs on past the next one's first new frame (to the end of
 //!   two prompts' written overlap, at least [`PROMPT_BLEND`] frames where the prompt
 //!   changes, [`SEAM_BLEND`] where it continues), and the next window holds those frames
@@ -57,6 +62,29 @@ pub const PROMPT_BLEND: usize = 20;
 /// steps pull the free frames the fade lets go of too quickly); with 20, 0.083 against
 /// 0.097 inside the windows (the book's timeline page).
 pub const SEAM_BLEND: usize = 20;
+
+/// The fewest new frames a window is cut to for a short action ([`LongRequest::action_frames`]).
+pub const MIN_ACTION_FRAMES: usize = 40;
+
+/// [`LongRequest::action_frames`] of every prompt of `timelines`: the model's proposal for
+/// its length (the median length of its nearest caption's training clips), where the
+/// bundle has one.
+pub fn action_frames(
+    text: &crate::model::prompt::PromptEncoder,
+    timelines: &[Vec<PromptSpan>],
+    max_frames: usize,
+) -> Vec<(String, usize)> {
+    let mut out: Vec<(String, usize)> = Vec::new();
+    for span in timelines.iter().flatten() {
+        if out.iter().any(|(p, _)| *p == span.prompt) {
+            continue;
+        }
+        if let Some((frames, _)) = text.natural_frames(&span.prompt, max_frames) {
+            out.push((span.prompt.clone(), frames));
+        }
+    }
+    out
+}
 
 /// A take a long request edits (`mprog run --from` with a take longer than the model
 /// makes, or with a prompt timeline): each window edits its stretch of the take, the frames
@@ -164,6 +192,10 @@ pub struct LongRequest {
     pub resample: usize,
     /// The take edited, if any: each window then edits its stretch of it.
     pub take: Option<LongTake>,
+    /// Per prompt, the frames of its action (the median length of the training clips of
+    /// its nearest caption): windows under it make at most that many new frames. Empty:
+    /// every window as long as the model makes.
+    pub action_frames: Vec<(String, usize)>,
 }
 
 impl LongRequest {
@@ -190,6 +222,7 @@ impl LongRequest {
             clean_feet: false,
             resample: DEFAULT_WINDOW_RESAMPLE,
             take: None,
+            action_frames: Vec::new(),
         }
     }
 
@@ -228,12 +261,15 @@ impl Window {
 }
 
 /// Cuts a timeline into windows of at most `max_frames`, each after the first keeping
-/// `context` frames of the one before and blending into it. See the module docs.
+/// `context` frames of the one before and blending into it; under a prompt listed in
+/// `action_frames`, at most that many new frames (at least [`MIN_ACTION_FRAMES`]). See the
+/// module docs.
 pub fn plan_windows(
     timelines: &[Vec<PromptSpan>],
     frames: usize,
     max_frames: usize,
     context: usize,
+    action_frames: &[(String, usize)],
 ) -> Result<Vec<Window>, SolveError> {
     let bad = |m: String| Err(SolveError::Invalid(m));
     if timelines.is_empty() {
@@ -304,8 +340,19 @@ pub fn plan_windows(
         let out_blend = if next < frames { blend_at(next) } else { 0 };
         // Every window but the very first keeps `context` frames; each runs on one frame
         // past its blend (a take of F frames has F − 1 feature rows).
+        let action = (0..timelines.len())
+            .filter_map(|p| {
+                let prompt = prompt_at(p, cut);
+                action_frames
+                    .iter()
+                    .find(|(a, _)| *a == prompt)
+                    .map(|&(_, f)| f)
+            })
+            .min()
+            .map_or(usize::MAX, |f| f.max(MIN_ACTION_FRAMES));
         let capacity = max_frames
             .saturating_sub(context + out_blend.max(seam_blend) + 1)
+            .min(action)
             .max(1);
         let total = next - cut;
         let count = total.div_ceil(capacity).max(1);
@@ -464,7 +511,13 @@ pub fn solve_long(
     mut on_progress: impl FnMut(LongProgress),
 ) -> Result<SolveResult, SolveError> {
     let started = Instant::now();
-    let windows = plan_windows(&req.timelines, req.frames, prior.max_frames, req.context)?;
+    let windows = plan_windows(
+        &req.timelines,
+        req.frames,
+        prior.max_frames,
+        req.context,
+        &req.action_frames,
+    )?;
     if windows.len() > 1
         && let Some(why) = req.solver.edit_refusal()
     {
@@ -766,9 +819,33 @@ mod tests {
     }
 
     #[test]
+    fn a_short_action_gets_windows_of_its_own_length() {
+        let line = vec![vec![
+            span(0, 140, "a person walks forward"),
+            span(140, 260, "a person runs forward"),
+        ]];
+        let plain = plan_windows(&line, 260, 196, 20, &[]).unwrap();
+        let actions = [("a person runs forward".to_string(), 62)];
+        let w = plan_windows(&line, 260, 196, 20, &actions).unwrap();
+        check_plan(&w, 260, 196, 20);
+        assert_eq!(plain.len(), 2, "the walk, then the 6 s run in one window");
+        assert_eq!(w.len(), 3, "the walk, then the run as two 3 s windows");
+        assert_eq!((w[1].cut, w[2].cut), (140, 200));
+        assert!(
+            w.iter()
+                .all(|w| w.prompts[0] != "a person runs forward" || w.end - w.cut <= 62 + 21)
+        );
+        // Never under MIN_ACTION_FRAMES new frames, and no change for a long action.
+        let tiny = [("a person runs forward".to_string(), 5)];
+        assert_eq!(plan_windows(&line, 260, 196, 20, &tiny).unwrap().len(), 4);
+        let long = [("a person walks forward".to_string(), 190)];
+        assert_eq!(plan_windows(&line, 260, 196, 20, &long).unwrap(), plain);
+    }
+
+    #[test]
     fn a_long_motion_is_cut_into_windows_that_keep_the_second_before() {
         let line = vec![vec![span(0, 600, "a person walks forward")]];
-        let w = plan_windows(&line, 600, 196, 20).unwrap();
+        let w = plan_windows(&line, 600, 196, 20, &[]).unwrap();
         check_plan(&w, 600, 196, 20);
         assert_eq!(w.len(), 4, "600 frames at 155 new frames a window");
         // Each window runs on SEAM_BLEND frames; the next fades them out, flat at both ends.
@@ -790,7 +867,7 @@ mod tests {
             span(150, 280, "jog"),
             span(280, 400, "sit"),
         ]];
-        let w = plan_windows(&line, 400, 196, 20).unwrap();
+        let w = plan_windows(&line, 400, 196, 20, &[]).unwrap();
         check_plan(&w, 400, 196, 20);
         let prompts: Vec<&str> = w.iter().map(|w| w.prompts[0].as_str()).collect();
         assert_eq!(prompts, ["walk", "jog", "sit"]);
@@ -815,7 +892,7 @@ mod tests {
             vec![span(0, 100, "walk"), span(100, 200, "wave")],
             vec![span(0, 150, "stand"), span(150, 200, "sit")],
         ];
-        let w = plan_windows(&lines, 200, 196, 20).unwrap();
+        let w = plan_windows(&lines, 200, 196, 20, &[]).unwrap();
         check_plan(&w, 200, 196, 20);
         let pairs: Vec<(usize, [&str; 2])> = w
             .iter()
@@ -834,15 +911,15 @@ mod tests {
     #[test]
     fn bad_timelines_are_refused() {
         let gap = vec![vec![span(0, 50, "a"), span(60, 100, "b")]];
-        assert!(plan_windows(&gap, 100, 196, 20).is_err());
+        assert!(plan_windows(&gap, 100, 196, 20, &[]).is_err());
         let short = vec![vec![span(0, 50, "a")]];
-        assert!(plan_windows(&short, 100, 196, 20).is_err());
+        assert!(plan_windows(&short, 100, 196, 20, &[]).is_err());
         let ok = vec![vec![span(0, 100, "a")]];
         assert!(
-            plan_windows(&ok, 100, 196, 190).is_err(),
+            plan_windows(&ok, 100, 196, 190, &[]).is_err(),
             "context leaves no new frames"
         );
-        assert!(plan_windows(&[], 100, 196, 20).is_err());
+        assert!(plan_windows(&[], 100, 196, 20, &[]).is_err());
     }
 
     /// Right wrist at least 1.6 m up on frame `frame`, counting only frames before `until`.
@@ -905,7 +982,7 @@ mod tests {
         assert!(m.frames[8][21].y > 1.55 && m.frames[80][21].y > 1.55);
         // The seams are as smooth as the windows: the largest pelvis step across a seam
         // is no larger than twice the largest inside the windows.
-        let plan = plan_windows(&req.timelines, 90, 40, 10).unwrap();
+        let plan = plan_windows(&req.timelines, 90, 40, 10, &[]).unwrap();
         let step = |t: usize| (m.frames[t + 1][0] - m.frames[t][0]).length();
         let seams: Vec<usize> = plan[1..].iter().flat_map(|w| w.start..w.cut + 2).collect();
         let seam = seams.iter().map(|&t| step(t)).fold(0.0, f32::max);
