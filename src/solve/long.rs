@@ -9,9 +9,10 @@
 //!   ([`super::edit`]), and the model continues them under the window's own prompt.
 //! * **Actions at their own length.** A prompt whose training clips are shorter than the
 //!   model's length ([`LongRequest::action_frames`], the bundle's median clip length of the
-//!   nearest caption) gets windows of at most that many new frames: "a person runs
-//!   forward" is a run at its clips' 3.1 s (2.7 m/s) and a jog in one 7 s window
-//!   (1.3–1.5 m/s), so a 6 s run span is made as two runs of 3 s.
+//!   nearest caption) gets windows no longer than that, context and blend included (at
+//!   least [`MIN_ACTION_FRAMES`] new frames): "a person runs forward" is a run at its
+//!   clips' 3.1 s (2.7 m/s) and a jog in one 7 s window (1.3–1.5 m/s), so a 6 s run span
+//!   is made as three windows of 2 s new frames each.
 //! * **Blends.** Each window runs on past the next one's first new frame (to the end of
 //!   two prompts' written overlap, at least [`PROMPT_BLEND`] frames where the prompt
 //!   changes, [`SEAM_BLEND`] where it continues), and the next window holds those frames
@@ -193,8 +194,8 @@ pub struct LongRequest {
     /// The take edited, if any: each window then edits its stretch of it.
     pub take: Option<LongTake>,
     /// Per prompt, the frames of its action (the median length of the training clips of
-    /// its nearest caption): windows under it make at most that many new frames. Empty:
-    /// every window as long as the model makes.
+    /// its nearest caption): windows under it are no longer, context and blend included.
+    /// Empty: every window as long as the model makes.
     pub action_frames: Vec<(String, usize)>,
 }
 
@@ -262,8 +263,8 @@ impl Window {
 
 /// Cuts a timeline into windows of at most `max_frames`, each after the first keeping
 /// `context` frames of the one before and blending into it; under a prompt listed in
-/// `action_frames`, at most that many new frames (at least [`MIN_ACTION_FRAMES`]). See the
-/// module docs.
+/// `action_frames`, windows no longer than that, context and blend included (at least
+/// [`MIN_ACTION_FRAMES`] new frames). See the module docs.
 pub fn plan_windows(
     timelines: &[Vec<PromptSpan>],
     frames: usize,
@@ -349,7 +350,13 @@ pub fn plan_windows(
                     .map(|&(_, f)| f)
             })
             .min()
-            .map_or(usize::MAX, |f| f.max(MIN_ACTION_FRAMES));
+            // The whole window (context, new frames, blend) as long as the action: with
+            // only its new frames that long, a 6 s run span made 1.61 m/s, the walk held
+            // before each window slowing it; this way 1.96 m/s.
+            .map_or(usize::MAX, |f| {
+                f.saturating_sub(context + prompt_blend + 1)
+                    .max(MIN_ACTION_FRAMES)
+            });
         let capacity = max_frames
             .saturating_sub(context + out_blend.max(seam_blend) + 1)
             .min(action)
@@ -829,16 +836,18 @@ mod tests {
         let w = plan_windows(&line, 260, 196, 20, &actions).unwrap();
         check_plan(&w, 260, 196, 20);
         assert_eq!(plain.len(), 2, "the walk, then the 6 s run in one window");
-        assert_eq!(w.len(), 3, "the walk, then the run as two 3 s windows");
-        assert_eq!((w[1].cut, w[2].cut), (140, 200));
-        assert!(
-            w.iter()
-                .all(|w| w.prompts[0] != "a person runs forward" || w.end - w.cut <= 62 + 21)
+        assert_eq!(
+            w.len(),
+            4,
+            "the walk, then the run as three windows of 2 s new frames"
         );
+        assert_eq!((w[1].cut, w[2].cut, w[3].cut), (140, 180, 220));
+        // 62 − context − blend − 1 is under MIN_ACTION_FRAMES: 40 new frames a window.
+        assert_eq!(w[3].cut - w[2].cut, MIN_ACTION_FRAMES);
         // Never under MIN_ACTION_FRAMES new frames, and no change for a long action.
         let tiny = [("a person runs forward".to_string(), 5)];
         assert_eq!(plan_windows(&line, 260, 196, 20, &tiny).unwrap().len(), 4);
-        let long = [("a person walks forward".to_string(), 190)];
+        let long = [("a person walks forward".to_string(), 196)];
         assert_eq!(plan_windows(&line, 260, 196, 20, &long).unwrap(), plain);
     }
 
