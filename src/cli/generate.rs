@@ -267,7 +267,13 @@ pub fn run(mut args: GenArgs) -> Result<()> {
             mprog::lang::check::MAX_LENGTH
         ));
     }
-    let long = frames > bundle.config.max_frames;
+    // Longer than the model makes, or an action asked for over much more than its clips'
+    // length: in windows of that length (`solve::long::ACTION_STRETCH`).
+    let line = one_prompt(&args.text, frames);
+    let actions = mprog::solve::long::action_frames(&bundle.text, &line, bundle.config.max_frames);
+    let stretched =
+        !args.mirror_average && mprog::solve::long::stretches_an_action(&line, &actions);
+    let long = frames > bundle.config.max_frames || stretched;
     let mut out = if long {
         generate_long(&bundle, &args, frames, sampler, &device, &bar, &interrupt)?
     } else {
@@ -282,10 +288,27 @@ pub fn run(mut args: GenArgs) -> Result<()> {
     };
     bar.finish_and_clear();
     if long {
+        let longest = mprog::solve::long::plan_windows(
+            &line,
+            frames,
+            bundle.config.max_frames,
+            seam_context_frames(args.seam_context)?,
+            &actions,
+        )
+        .into_diagnostic()?
+        .iter()
+        .map(|w| w.len())
+        .max()
+        .unwrap_or(frames);
         eprintln!(
-            "{:.1} s made in windows of at most {:.1} s, each keeping {:.1} s of the one before{}",
+            "{:.1} s made in windows of at most {:.1} s{}, each keeping {:.1} s of the one before{}",
             frames as f32 / 20.0,
-            bundle.config.max_frames as f32 / 20.0,
+            longest as f32 / 20.0,
+            if stretched {
+                " (the prompt's training clips are shorter than the motion asked for)"
+            } else {
+                ""
+            },
             mprog::solve::long::DEFAULT_CONTEXT as f32 / 20.0,
             if args.raw {
                 ""

@@ -67,6 +67,25 @@ pub const SEAM_BLEND: usize = 20;
 /// The fewest new frames a window is cut to for a short action ([`LongRequest::action_frames`]).
 pub const MIN_ACTION_FRAMES: usize = 40;
 
+/// A prompt asked for over more than this multiple of its action's length is made in
+/// windows of that length even where one window would hold it (`gen`): "a person jumps
+/// up and down in place" over 8 s in one window never left the floor (lowest foot at most
+/// 0.048 m, seeds 1 and 2); in windows of the jump's own length it jumped (0.30–0.31 m).
+pub const ACTION_STRETCH: f32 = 1.5;
+
+/// Whether some span of `timelines` is longer than [`ACTION_STRETCH`] × its prompt's
+/// action ([`action_frames`]).
+pub fn stretches_an_action(
+    timelines: &[Vec<PromptSpan>],
+    action_frames: &[(String, usize)],
+) -> bool {
+    timelines.iter().flatten().any(|span| {
+        action_frames.iter().any(|(prompt, frames)| {
+            *prompt == span.prompt && (span.to - span.from) as f32 > ACTION_STRETCH * *frames as f32
+        })
+    })
+}
+
 /// [`LongRequest::action_frames`] of every prompt of `timelines`: the model's proposal for
 /// its length (the median length of its nearest caption's training clips), where the
 /// bundle has one.
