@@ -131,46 +131,17 @@ pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
 /// ([`mprog::solve::long`]), each window continuing the last second of the one before.
 fn generate_long(
     bundle: &ModelBundle,
-    args: &GenArgs,
-    frames: usize,
-    sampler: SamplerKind,
+    req: &mprog::solve::long::LongRequest,
     device: &burn::prelude::Device,
     bar: &ProgressBar,
     interrupt: &Interrupt,
 ) -> Result<mprog::model::generate::Generated> {
-    use mprog::solve::long::{LongProgress, LongRequest, solve_long};
-    if args.mirror_average {
-        return Err(miette::miette!(
-            help = format!(
-                "drop --mirror-average, or ask for at most {:.1} s",
-                bundle.config.max_frames as f32 / 20.0
-            ),
-            "--mirror-average is not available for motions made in windows"
-        ));
-    }
-    let req = LongRequest {
-        samples: args.count.max(1),
-        guidance_scale: args.guidance,
-        clean_feet: !args.raw,
-        context: seam_context_frames(args.seam_context)?,
-        resample: args.seam_resample,
-        action_frames: mprog::solve::long::action_frames(
-            &bundle.text,
-            &one_prompt(&args.text, frames),
-            bundle.config.max_frames,
-        ),
-        ..LongRequest::new(
-            vec![args.text.clone()],
-            frames,
-            args.seed,
-            mprog::solve::Solver::plain(sampler),
-        )
-    };
+    use mprog::solve::long::{LongProgress, solve_long};
     let nothing =
         |j: burn::tensor::Tensor<5>| burn::tensor::Tensor::<1>::zeros([j.dims()[0]], &j.device());
     let out = solve_long(
         &mprog::solve::Prior::from_bundle(bundle),
-        &req,
+        req,
         &nothing,
         device,
         |p: LongProgress| {
@@ -274,8 +245,44 @@ pub fn run(mut args: GenArgs) -> Result<()> {
     let stretched =
         !args.mirror_average && mprog::solve::long::stretches_an_action(&line, &actions);
     let long = frames > bundle.config.max_frames || stretched;
+    let windows = if long {
+        let w = mprog::solve::long::plan_windows(
+            &line,
+            frames,
+            bundle.config.max_frames,
+            seam_context_frames(args.seam_context)?,
+            &actions,
+        )
+        .into_diagnostic()?;
+        Some(w)
+    } else {
+        None
+    };
     let mut out = if long {
-        generate_long(&bundle, &args, frames, sampler, &device, &bar, &interrupt)?
+        if args.mirror_average {
+            return Err(miette::miette!(
+                help = format!(
+                    "drop --mirror-average, or ask for at most {:.1} s",
+                    bundle.config.max_frames as f32 / 20.0
+                ),
+                "--mirror-average is not available for motions made in windows"
+            ));
+        }
+        let req = mprog::solve::long::LongRequest {
+            samples: args.count.max(1),
+            guidance_scale: args.guidance,
+            clean_feet: !args.raw,
+            context: seam_context_frames(args.seam_context)?,
+            resample: args.seam_resample,
+            action_frames: actions,
+            ..mprog::solve::long::LongRequest::new(
+                vec![args.text.clone()],
+                frames,
+                args.seed,
+                mprog::solve::Solver::plain(sampler),
+            )
+        };
+        generate_long(&bundle, &req, &device, &bar, &interrupt)?
     } else {
         match generate_interruptible(&bundle, &req, &device, progress, &interrupt) {
             Err(e @ GenerateError::Interrupted { .. }) => {
@@ -287,19 +294,8 @@ pub fn run(mut args: GenArgs) -> Result<()> {
         }
     };
     bar.finish_and_clear();
-    if long {
-        let longest = mprog::solve::long::plan_windows(
-            &line,
-            frames,
-            bundle.config.max_frames,
-            seam_context_frames(args.seam_context)?,
-            &actions,
-        )
-        .into_diagnostic()?
-        .iter()
-        .map(|w| w.len())
-        .max()
-        .unwrap_or(frames);
+    if let Some(windows) = &windows {
+        let longest = windows.iter().map(|w| w.len()).max().unwrap_or(frames);
         eprintln!(
             "{:.1} s made in windows of at most {:.1} s{}, each keeping {:.1} s of the one before{}",
             frames as f32 / 20.0,
@@ -335,17 +331,8 @@ pub fn run(mut args: GenArgs) -> Result<()> {
     meta.insert("sampler".into(), format!("{sampler:?}").into());
     meta.insert("guidance_scale".into(), (args.guidance as f64).into());
     meta.insert("foot_cleanup".into(), (!args.raw).into());
-    if long {
-        let line = one_prompt(&args.text, frames);
-        let windows = mprog::solve::long::plan_windows(
-            &line,
-            frames,
-            bundle.config.max_frames,
-            seam_context_frames(args.seam_context)?,
-            &mprog::solve::long::action_frames(&bundle.text, &line, bundle.config.max_frames),
-        )
-        .into_diagnostic()?;
-        meta.insert("windows".into(), windows_meta(&windows));
+    if let Some(windows) = &windows {
+        meta.insert("windows".into(), windows_meta(windows));
         meta.insert("seam_resample".into(), args.seam_resample.into());
     }
     if let Some(snapped) = bundle.text.snapped(&args.text) {

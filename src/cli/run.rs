@@ -173,6 +173,8 @@ struct Windowed<'a> {
     context: usize,
     resample: usize,
     take: Option<&'a LongTake>,
+    /// The prompts' action lengths the windows are cut to.
+    actions: &'a [(String, usize)],
 }
 
 /// The actions' own lengths the windows are cut to ([`mprog::solve::long::action_frames`]);
@@ -218,6 +220,7 @@ fn solve_with_bar(
             context,
             resample,
             take,
+            actions,
         }) => {
             let long = LongRequest {
                 timelines: lines.to_vec(),
@@ -230,7 +233,7 @@ fn solve_with_bar(
                 // polishes the window's statements after its cleanup, which a cleanup
                 // without a polish left 2 cm short (a timeline's `at 11s`).
                 clean_feet: req.clean_feet,
-                action_frames: window_actions(bundle, lines, take.is_some()),
+                action_frames: actions.to_vec(),
                 ..LongRequest::new(Vec::new(), req.frames, req.seed, req.solver.clone())
             };
             solve_long(&prior, &long, error, device, |p: LongProgress| {
@@ -328,11 +331,16 @@ pub fn run(mut args: RunArgs) -> Result<()> {
         _ => None,
     };
     let context = super::generate::seam_context_frames(args.seam_context)?;
+    let actions = match windowed {
+        true => window_actions(&bundle, &timelines, long_take.is_some()),
+        false => Vec::new(),
+    };
     let windows = windowed.then_some(Windowed {
         timelines: &timelines,
         context,
         resample: args.seam_resample,
         take: long_take.as_ref(),
+        actions: &actions,
     });
     let window_plan = if windowed {
         let w = mprog::solve::long::plan_windows(
@@ -340,7 +348,7 @@ pub fn run(mut args: RunArgs) -> Result<()> {
             frames,
             bundle.config.max_frames,
             context,
-            &window_actions(&bundle, &timelines, long_take.is_some()),
+            &actions,
         )
         .into_diagnostic()?;
         eprintln!(

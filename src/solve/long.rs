@@ -358,8 +358,6 @@ pub fn plan_windows(
     for (i, &cut) in cuts.iter().enumerate() {
         let next = cuts.get(i + 1).copied().unwrap_or(frames);
         let out_blend = if next < frames { blend_at(next) } else { 0 };
-        // Every window but the very first keeps `context` frames; each runs on one frame
-        // past its blend (a take of F frames has F − 1 feature rows).
         let action = (0..timelines.len())
             .filter_map(|p| {
                 let prompt = prompt_at(p, cut);
@@ -376,6 +374,8 @@ pub fn plan_windows(
                 f.saturating_sub(context + prompt_blend + 1)
                     .max(MIN_ACTION_FRAMES)
             });
+        // Every window but the very first keeps `context` frames; each runs on one frame
+        // past its blend (a take of F frames has F − 1 feature rows).
         let capacity = max_frames
             .saturating_sub(context + out_blend.max(seam_blend) + 1)
             .min(action)
