@@ -200,6 +200,7 @@ fn tiny_bundle(dir: &Path) {
             half_precision: false,
             text_encoder_id: None,
             control_id: None,
+            consistency: None,
         },
     };
     bundle.save(dir).unwrap();

@@ -68,6 +68,7 @@ fn bundle(dir: &Path, config: ModelConfig) {
             half_precision: true,
             text_encoder_id: None,
             control_id: None,
+            consistency: None,
         },
     }
     .save(dir)

@@ -228,6 +228,30 @@ pub fn run(args: TaskBenchArgs) -> Result<()> {
     let control = ControlNet::load(&dir, &bundle.model, bundle.manifest.half_precision, &device)
         .into_diagnostic()?;
     let prior = Prior::from_bundle(&bundle).with_control(control.as_ref());
+    // A few-step model runs only the solvers that can use its chain, and `latent-fast`
+    // needs one: the others are named and left out.
+    let few_step = bundle.manifest.consistency.is_some();
+    let (list, skipped): (Vec<_>, Vec<_>) =
+        list.into_iter().partition(|(s, _)| s.runs_on(few_step));
+    if !skipped.is_empty() {
+        let names: Vec<&str> = skipped.iter().map(|(_, l)| l.as_str()).collect();
+        eprintln!(
+            "skipped on {}: {} ({})",
+            bundle.manifest.weights_id,
+            names.join(", "),
+            if few_step {
+                "they need a diffusion model"
+            } else {
+                "it needs a few-step model: pass --model models/fast"
+            }
+        );
+    }
+    if list.is_empty() {
+        return Err(miette!(
+            "no chosen solver runs on {}",
+            bundle.manifest.weights_id
+        ));
+    }
     let list = with_no_realism_guide(list, control.is_some())?;
     let mut tasks: Vec<Task> = program_suite(&args.programs, &size).map_err(|e| miette!("{e}"))?;
     let data = match Dataset::load(&args.data) {

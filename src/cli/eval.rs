@@ -51,15 +51,16 @@ struct RunArgs {
     /// Seed of the clip choice, captions and noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Sampler: `ddim` (deterministic) or `ddpm` (stochastic, seeded).
-    #[arg(long, default_value = "ddim")]
-    sampler: String,
-    /// Denoising steps (DDIM default 50, DDPM default 1000; fewer are respaced).
+    /// Sampler: `ddim` (deterministic), `ddpm` (stochastic, seeded), or `lcm` (a
+    /// consistency-distilled model's few-step chain; such a model's default).
+    #[arg(long)]
+    sampler: Option<String>,
+    /// Denoising steps (DDIM default 50, DDPM default 1000, lcm 4; fewer are respaced).
     #[arg(long, alias = "ddim-steps")]
     steps: Option<usize>,
-    /// Classifier-free guidance scale.
-    #[arg(long, default_value_t = 2.5, value_parser = super::parse_guidance, allow_hyphen_values = true)]
-    guidance: f32,
+    /// Classifier-free guidance scale (default 2.5; 1 for a consistency-distilled model).
+    #[arg(long, value_parser = super::parse_guidance, allow_hyphen_values = true)]
+    guidance: Option<f32>,
     /// Motions generated per call.
     #[arg(long, default_value_t = 16)]
     batch: usize,
@@ -162,7 +163,7 @@ fn evaluate(args: RunArgs) -> Result<()> {
     if args.count < 2 || args.batch == 0 || args.steps == Some(0) {
         return Err(miette!("--count must be ≥ 2, --batch and --steps ≥ 1"));
     }
-    let sampler = super::generate::sampler_kind(&args.sampler, args.steps)?;
+    super::generate::check_sampler_name(args.sampler.as_deref())?;
     let data_dir = args.data.ok_or_else(|| miette!("--data is required"))?;
     let device = super::device()?;
     let data = Dataset::load(&data_dir).into_diagnostic()?;
@@ -179,11 +180,17 @@ fn evaluate(args: RunArgs) -> Result<()> {
                 eval_dir.display()
             )
         })?;
+    let (sampler, guidance_scale) = super::generate::sampling_for(
+        &bundle.manifest,
+        args.sampler.as_deref(),
+        args.steps,
+        args.guidance,
+    )?;
     let settings = EvalSettings {
         count: args.count,
         seed: args.seed,
         sampler,
-        guidance_scale: args.guidance,
+        guidance_scale,
         batch_size: args.batch,
         min_frames: args.min_frames,
         per_label: args.per_label.then_some(args.per_label_count),

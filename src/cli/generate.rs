@@ -34,15 +34,17 @@ pub struct GenArgs {
     /// Number of motions, generated as one batch (outputs get `_0`, `_1`, … suffixes).
     #[arg(long, default_value_t = 1)]
     count: usize,
-    /// Sampler: `ddim` (deterministic) or `ddpm`.
-    #[arg(long, default_value = "ddim")]
-    sampler: String,
-    /// Denoising steps (DDIM default 50; DDPM 1000 is the full chain).
+    /// Sampler: `ddim` (deterministic), `ddpm`, or `lcm` (a consistency-distilled
+    /// model's few-step chain; such a model's default). Default: ddim.
+    #[arg(long)]
+    sampler: Option<String>,
+    /// Denoising steps (DDIM default 50; DDPM 1000 is the full chain; lcm 4).
     #[arg(long)]
     steps: Option<usize>,
-    /// Classifier-free guidance scale.
-    #[arg(long, default_value_t = 2.5, value_parser = super::parse_guidance, allow_hyphen_values = true)]
-    guidance: f32,
+    /// Classifier-free guidance scale (default 2.5; 1 for a consistency-distilled model,
+    /// whose teacher's guidance is in its weights).
+    #[arg(long, value_parser = super::parse_guidance, allow_hyphen_values = true)]
+    guidance: Option<f32>,
     /// Average every denoising step with its left/right mirror (swapped sides in the
     /// motion and the prompt): left and right turns become exact mirrors; twice the work.
     #[arg(long)]
@@ -115,17 +117,56 @@ pub(super) fn windows_meta(windows: &[mprog::solve::long::Window]) -> serde_json
     )
 }
 
-/// Parses `--sampler`/`--steps`.
-pub fn sampler_kind(name: &str, steps: Option<usize>) -> Result<SamplerKind> {
+/// Checks a `--sampler` name before anything is loaded.
+pub fn check_sampler_name(name: Option<&str>) -> Result<()> {
     match name {
-        "ddim" => Ok(SamplerKind::Ddim(steps.unwrap_or(50))),
-        "ddpm" => Ok(SamplerKind::Ddpm(steps.unwrap_or(1000))),
-        other => Err(miette::miette!(
-            help = "use ddim or ddpm",
+        None | Some("ddim" | "ddpm" | "lcm") => Ok(()),
+        Some(other) => Err(miette::miette!(
+            help = "use ddim, ddpm, or lcm (for a consistency-distilled model)",
             "unknown sampler `{other}`"
         )),
     }
 }
+
+/// The chain and guidance scale for `--sampler`/`--steps`/`--guidance` and a bundle: a
+/// consistency-distilled bundle samples its few-step chain (4 steps) at scale 1 (its
+/// teacher's guidance is in the weights); any other bundle DDIM-50 at 2.5.
+pub fn sampling_for(
+    bundle: &mprog::model::weights::Manifest,
+    name: Option<&str>,
+    steps: Option<usize>,
+    guidance: Option<f32>,
+) -> Result<(SamplerKind, f32)> {
+    check_sampler_name(name)?;
+    let kind = match (name, &bundle.consistency) {
+        (None | Some("lcm"), Some(c)) => SamplerKind::Consistency {
+            steps: steps.unwrap_or(DEFAULT_CONSISTENCY_STEPS).min(c.grid),
+            grid: c.grid,
+        },
+        (Some("lcm"), None) => {
+            return Err(miette::miette!(
+                help =
+                    "pass --model with a bundle written by a `[distil]` training run, or use ddim",
+                "--sampler lcm needs a consistency-distilled model; {} is a diffusion model",
+                bundle.weights_id
+            ));
+        }
+        (Some("ddpm"), _) => SamplerKind::Ddpm(steps.unwrap_or(1000)),
+        _ => SamplerKind::Ddim(steps.unwrap_or(50)),
+    };
+    let scale = match (&bundle.consistency, guidance) {
+        (_, Some(g)) => g,
+        (Some(_), None) => 1.0,
+        (None, None) => DEFAULT_GUIDANCE,
+    };
+    Ok((kind, scale))
+}
+
+/// Classifier-free guidance scale of a diffusion bundle when `--guidance` is not given.
+pub const DEFAULT_GUIDANCE: f32 = 2.5;
+
+/// Steps of a consistency model's chain when `--steps` is not given.
+pub const DEFAULT_CONSISTENCY_STEPS: usize = mprog::model::sampler::FEW_STEPS;
 
 /// A `gen` longer than the model makes: the unguided chain window by window
 /// ([`mprog::solve::long`]), each window continuing the last second of the one before.
@@ -179,6 +220,7 @@ fn one_prompt(text: &str, frames: usize) -> Vec<Vec<mprog::solve::long::PromptSp
 /// Runs `mprog gen`.
 pub fn run(mut args: GenArgs) -> Result<()> {
     let started = Instant::now();
+    check_sampler_name(args.sampler.as_deref())?;
     check_outputs(&args.out)?;
     args.export.prepare(&args.out)?;
     let device = super::device()?;
@@ -208,13 +250,18 @@ pub fn run(mut args: GenArgs) -> Result<()> {
             None => DEFAULT_FRAMES,
         },
     };
-    let sampler = sampler_kind(&args.sampler, args.steps)?;
+    let (sampler, guidance) = sampling_for(
+        &bundle.manifest,
+        args.sampler.as_deref(),
+        args.steps,
+        args.guidance,
+    )?;
     let req = GenerateRequest {
         prompts: vec![args.text.clone(); args.count.max(1)],
         frames,
         seed: args.seed,
         sampler,
-        guidance_scale: args.guidance,
+        guidance_scale: guidance,
         mirror_average: args.mirror_average,
     };
     let bar = ProgressBar::new(0);
@@ -270,7 +317,7 @@ pub fn run(mut args: GenArgs) -> Result<()> {
         }
         let req = mprog::solve::long::LongRequest {
             samples: args.count.max(1),
-            guidance_scale: args.guidance,
+            guidance_scale: guidance,
             clean_feet: !args.raw,
             context: seam_context_frames(args.seam_context)?,
             resample: args.seam_resample,
@@ -329,7 +376,7 @@ pub fn run(mut args: GenArgs) -> Result<()> {
     meta.insert("text".into(), args.text.clone().into());
     meta.insert("seed".into(), args.seed.into());
     meta.insert("sampler".into(), format!("{sampler:?}").into());
-    meta.insert("guidance_scale".into(), (args.guidance as f64).into());
+    meta.insert("guidance_scale".into(), (guidance as f64).into());
     meta.insert("foot_cleanup".into(), (!args.raw).into());
     if let Some(windows) = &windows {
         meta.insert("windows".into(), windows_meta(windows));

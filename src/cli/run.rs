@@ -11,7 +11,7 @@ use mprog::formats::Meta;
 use mprog::lang::Program;
 use mprog::model::ModelBundle;
 use mprog::model::control::ControlNet;
-use mprog::model::weights::default_model_dir;
+use mprog::model::weights::{default_model_dir, fast_model_dir};
 use mprog::motion::Motion;
 use mprog::solve::long::{LongProgress, LongRequest, LongTake, PromptSpan, solve_long, timelines};
 use mprog::solve::{Prior, Progress, SolveRequest, SolveResult, Solver, solve};
@@ -282,7 +282,14 @@ pub fn run(mut args: RunArgs) -> Result<()> {
     check_outputs(&args.out)?;
     args.export.prepare(&args.out)?;
     let device = super::device()?;
-    let dir = args.model.clone().unwrap_or_else(default_model_dir);
+    // `latent-fast` needs the few-step model: the shipped one unless --model names another.
+    let dir = args.model.clone().unwrap_or_else(|| {
+        if solver.name() == "latent-fast" {
+            fast_model_dir()
+        } else {
+            default_model_dir()
+        }
+    });
     let mut bundle = ModelBundle::load(&dir, &device)
         .into_diagnostic()
         .wrap_err("cannot load the model (train one with `mprog train`, or pass --model)")?;

@@ -9,6 +9,7 @@ fn sampler_name(s: SamplerKind) -> String {
     match s {
         SamplerKind::Ddim(n) => format!("DDIM {n}"),
         SamplerKind::Ddpm(n) => format!("DDPM {n}"),
+        SamplerKind::Consistency { steps, grid } => format!("consistency {steps} (grid {grid})"),
     }
 }
 

@@ -281,6 +281,7 @@ fn tiny_bundle(data: &Dataset, dev: &Device) -> ModelBundle {
             half_precision: false,
             text_encoder_id: None,
             control_id: None,
+            consistency: None,
         },
     }
 }

@@ -226,6 +226,47 @@ pub struct TrainConfig {
     pub hold_pad: f64,
     /// Seed of the data order and noise.
     pub seed: u64,
+    /// Consistency distillation of a teacher bundle into a few-step model, instead of
+    /// the x0 loss (`model::train::distil`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub distil: Option<DistilConfig>,
+}
+
+/// Settings of a consistency-distillation run (MotionLCM §3.3, after LCM): the student
+/// learns to map any point of the teacher's guided DDIM trajectory to its end.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistilConfig {
+    /// The teacher's model bundle (its denoiser config must be the run's).
+    pub teacher: String,
+    /// The teacher's classifier-free guidance scale, baked into the student (which then
+    /// samples at scale 1).
+    pub guidance: f64,
+    /// Steps of the teacher's DDIM grid: each target is one teacher step of
+    /// 1000 / `grid` timesteps (the skipping step).
+    pub grid: usize,
+    /// Pseudo-Huber constant of the loss, in normalised feature units.
+    pub huber_c: f64,
+}
+
+impl DistilConfig {
+    /// Checks the numbers; the message names the field.
+    pub fn check(&self) -> Result<(), String> {
+        in_range("distil.grid", self.grid, 2, 1000)?;
+        if !(self.guidance.is_finite() && (1.0..=20.0).contains(&self.guidance)) {
+            return Err(format!(
+                "`distil.guidance` is {}; it must be in [1, 20]",
+                self.guidance
+            ));
+        }
+        if !(self.huber_c.is_finite() && self.huber_c > 0.0 && self.huber_c <= 1.0) {
+            return Err(format!(
+                "`distil.huber_c` is {}; it must be in (0, 1]",
+                self.huber_c
+            ));
+        }
+        Ok(())
+    }
 }
 
 fn default_paraphrase_min_cos() -> f64 {
@@ -276,6 +317,7 @@ impl Default for TrainConfig {
             text_noise: 0.0,
             hold_pad: 0.0,
             seed: 1,
+            distil: None,
         }
     }
 }
@@ -353,6 +395,9 @@ impl TrainConfig {
     /// Checks the settings (and the model shape); the message names the field.
     pub fn check(&self) -> Result<(), String> {
         self.model.check().map_err(|e| format!("[model] {e}"))?;
+        if let Some(d) = &self.distil {
+            d.check().map_err(|e| format!("[distil] {e}"))?;
+        }
         in_range("batch_size", self.batch_size, 1, MAX_SIZE)?;
         in_range("crop_frames", self.crop_frames, 2, MAX_SIZE)?;
         in_range("checkpoint_every", self.checkpoint_every, 1, usize::MAX)?;

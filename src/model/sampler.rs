@@ -4,7 +4,7 @@
 use super::denoiser::{Denoiser, DenoiserInput};
 use super::noise::NoiseSource;
 use super::prompt::{PromptEncoder, TextBatch};
-use super::schedule::NoiseSchedule;
+use super::schedule::{NoiseSchedule, consistency_timesteps};
 use burn::prelude::*;
 
 /// Which chain to run.
@@ -14,6 +14,37 @@ pub enum SamplerKind {
     Ddim(usize),
     /// Ancestral DDPM with this many (respaced) steps; 1000 = the full chain.
     Ddpm(usize),
+    /// A consistency model's multistep chain (LCM): `steps` jumps to x̂0 on its
+    /// distillation's DDIM grid of `grid` steps, re-noised in between.
+    Consistency {
+        /// Network passes.
+        steps: usize,
+        /// The distillation's grid (`Manifest::consistency`).
+        grid: usize,
+    },
+}
+
+/// Passes of a consistency model's chain unless asked otherwise (LCM's and MotionLCM's
+/// default: more steps add little).
+pub const FEW_STEPS: usize = 4;
+
+impl SamplerKind {
+    /// Steps of the chain.
+    pub fn steps(self) -> usize {
+        match self {
+            SamplerKind::Ddim(k) | SamplerKind::Ddpm(k) => k,
+            SamplerKind::Consistency { steps, .. } => steps,
+        }
+    }
+
+    /// The same kind with `steps` steps.
+    pub fn with_steps(self, steps: usize) -> SamplerKind {
+        match self {
+            SamplerKind::Ddim(_) => SamplerKind::Ddim(steps),
+            SamplerKind::Ddpm(_) => SamplerKind::Ddpm(steps),
+            SamplerKind::Consistency { grid, .. } => SamplerKind::Consistency { steps, grid },
+        }
+    }
 }
 
 /// The text condition of a batch, encoded once and reused at every step.
@@ -100,6 +131,22 @@ pub fn ddim_step(s: &NoiseSchedule, i: usize, x_t: Tensor<3>, x0: Tensor<3>) -> 
     x0 * a_prev.sqrt() + eps * (1.0 - a_prev).sqrt()
 }
 
+/// One step of a consistency chain from step `i` to `i − 1`: the clean estimate noised
+/// afresh to the previous step's level (x̂0 itself after the last).
+pub fn consistency_step(
+    s: &NoiseSchedule,
+    i: usize,
+    x0: Tensor<3>,
+    noise: &mut NoiseSource,
+) -> Tensor<3> {
+    if i == 0 {
+        return x0;
+    }
+    let a_prev = s.alphas_cumprod[i - 1];
+    let z = noise.tensor(x0.dims(), &x0.device());
+    x0 * a_prev.sqrt() + z * (1.0 - a_prev).sqrt()
+}
+
 /// Posterior mean μ(x̂0, x_t) of step `i`.
 pub fn posterior_mean(s: &NoiseSchedule, i: usize, x_t: Tensor<3>, x0: Tensor<3>) -> Tensor<3> {
     let p = s.posterior(i);
@@ -154,6 +201,7 @@ pub fn sample_chain_until(
                     mean
                 }
             }
+            SamplerKind::Consistency { .. } => consistency_step(schedule, i, x0, noise),
         };
         on_step(n - i, n);
     }
@@ -164,5 +212,6 @@ pub fn sample_chain_until(
 pub fn schedule_for(base: &NoiseSchedule, kind: SamplerKind) -> NoiseSchedule {
     match kind {
         SamplerKind::Ddim(k) | SamplerKind::Ddpm(k) => base.respaced(k),
+        SamplerKind::Consistency { steps, grid } => base.at(&consistency_timesteps(grid, steps)),
     }
 }

@@ -55,9 +55,21 @@ impl NoiseSchedule {
         let count = count.clamp(1, total);
         let stride = total / count;
         let kept: Vec<usize> = (0..count).map(|i| i * stride).collect();
+        self.at(&kept)
+    }
+
+    /// The steps of this schedule at the given step indices (any order; kept ascending,
+    /// once each), β re-derived from ᾱ at those steps.
+    pub fn at(&self, timesteps: &[usize]) -> Self {
+        let mut kept: Vec<usize> = timesteps
+            .iter()
+            .map(|&t| t.min(self.timesteps.len() - 1))
+            .collect();
+        kept.sort_unstable();
+        kept.dedup();
         let mut last = 1.0;
-        let mut betas = Vec::with_capacity(count);
-        let mut alphas = Vec::with_capacity(count);
+        let mut betas = Vec::with_capacity(kept.len());
+        let mut alphas = Vec::with_capacity(kept.len());
         for &k in &kept {
             let a = self.alphas_cumprod[k];
             betas.push(1.0 - a / last);
@@ -111,6 +123,27 @@ impl NoiseSchedule {
     }
 }
 
+/// A consistency model's boundary scalings at timestep `t` (LCM: σ_data 0.5, timestep
+/// scaling 10): f(x, t) = c_skip·x + c_out·x̂0, so f(x, 0) = x exactly and from t = 20 on
+/// f is the network's x̂0 within 1e-5.
+pub fn consistency_scalings(t: usize) -> (f64, f64) {
+    let sigma2 = 0.25;
+    let scaled = t as f64 * 10.0;
+    let c_skip = sigma2 / (scaled * scaled + sigma2);
+    let c_out = scaled / (scaled * scaled + sigma2).sqrt();
+    (c_skip, c_out)
+}
+
+/// Timesteps of a `steps`-step consistency chain on a `grid`-step DDIM grid, descending:
+/// LCM's rule, every (grid / steps)-th grid point from the top.
+pub fn consistency_timesteps(grid: usize, steps: usize) -> Vec<usize> {
+    let grid = grid.clamp(1, DIFFUSION_STEPS);
+    let stride = DIFFUSION_STEPS / grid;
+    let steps = steps.clamp(1, grid);
+    let skip = grid / steps;
+    (0..steps).map(|k| (grid - 1 - k * skip) * stride).collect()
+}
+
 /// Coefficients of the Gaussian posterior of one step.
 #[derive(Clone, Copy, Debug)]
 pub struct PosteriorCoefficients {
@@ -147,6 +180,17 @@ mod tests {
         for (i, &t) in r.timesteps.iter().enumerate() {
             assert!((r.alphas_cumprod[i] - s.alphas_cumprod[t]).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn consistency_chains_follow_lcm() {
+        assert_eq!(consistency_timesteps(50, 4), vec![980, 740, 500, 260]);
+        assert_eq!(consistency_timesteps(50, 1), vec![980]);
+        assert_eq!(consistency_timesteps(50, 2), vec![980, 480]);
+        let (skip, out) = consistency_scalings(0);
+        assert_eq!((skip, out), (1.0, 0.0));
+        let (skip, out) = consistency_scalings(20);
+        assert!(skip < 1e-5 && (out - 1.0).abs() < 1e-5, "{skip} {out}");
     }
 
     #[test]

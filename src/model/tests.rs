@@ -513,3 +513,92 @@ fn hold_padding_places_a_short_clip_inside_a_still_window() {
     );
     assert_eq!(plain.frames, 24);
 }
+
+#[test]
+fn distillation_fits_a_student_to_its_teacher_and_marks_the_bundle() {
+    use super::config::DistilConfig;
+    use super::generate::{GenerateRequest, generate};
+    use super::sampler::SamplerKind;
+    let data = synthetic_dataset();
+    let teacher = tempfile::tempdir().unwrap();
+    let config = TrainConfig {
+        learning_rate: 3e-3,
+        ..tiny_run_config()
+    };
+    let run = |out: &std::path::Path, config: TrainConfig, init, steps| TrainRun {
+        data: &data,
+        config,
+        out: out.to_path_buf(),
+        max_steps_now: Some(steps),
+        interrupt: Default::default(),
+        init_from: init,
+        device: Device::flex(),
+        after_checkpoint: None,
+        text_encoder: None,
+    };
+    run(teacher.path(), config.clone(), None, 20)
+        .run(&|_, _, _| {})
+        .unwrap();
+    let bundle_dir = teacher.path().join("bundle");
+    let distil = TrainConfig {
+        learning_rate: 1e-3,
+        ema_decay: 0.95,
+        distil: Some(DistilConfig {
+            teacher: bundle_dir.display().to_string(),
+            guidance: 2.5,
+            grid: 10,
+            huber_c: 0.03,
+        }),
+        ..config.clone()
+    };
+    let student = tempfile::tempdir().unwrap();
+    run(student.path(), distil.clone(), Some(bundle_dir.clone()), 40)
+        .run(&|_, _, _| {})
+        .unwrap();
+    let csv = std::fs::read_to_string(student.path().join("loss.csv")).unwrap();
+    let losses: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(losses.len(), 40);
+    assert!(losses.iter().all(|l| l.is_finite() && *l >= 0.0));
+    let early: f64 = losses[..10].iter().sum::<f64>() / 10.0;
+    let late: f64 = losses[30..].iter().sum::<f64>() / 10.0;
+    assert!(
+        late < early,
+        "the consistency loss did not fall: {early} -> {late}"
+    );
+    let bundle =
+        super::weights::ModelBundle::load(&student.path().join("bundle"), &Device::flex()).unwrap();
+    let c = bundle
+        .manifest
+        .consistency
+        .clone()
+        .expect("marked as a consistency model");
+    assert_eq!((c.grid, c.guidance), (10, 2.5));
+    assert!(bundle.manifest.weights_id.starts_with("lcm-"));
+    // It samples in two steps, deterministically.
+    let req = GenerateRequest {
+        prompts: vec!["walk".into()],
+        frames: 12,
+        seed: 3,
+        sampler: SamplerKind::Consistency { steps: 2, grid: 10 },
+        guidance_scale: 1.0,
+        mirror_average: false,
+    };
+    let mut steps = 0;
+    let a = generate(&bundle, &req, &Device::flex(), |_, _| steps += 1).unwrap();
+    let b = generate(&bundle, &req, &Device::flex(), |_, _| {}).unwrap();
+    assert_eq!(steps, 2);
+    assert_eq!(a.features, b.features);
+    // A consistency bundle cannot teach another.
+    let again = tempfile::tempdir().unwrap();
+    let mut from_student = distil;
+    from_student.distil.as_mut().unwrap().teacher =
+        student.path().join("bundle").display().to_string();
+    let err = run(again.path(), from_student, Some(bundle_dir), 1)
+        .run(&|_, _, _| {})
+        .unwrap_err();
+    assert!(err.to_string().contains("few-step"), "{err}");
+}

@@ -57,6 +57,21 @@ pub struct Manifest {
     /// bundle has one: it changes what `guide` makes, so outputs record it too.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control_id: Option<String>,
+    /// Set when the weights are a consistency model distilled from a guided teacher:
+    /// they sample in a few steps, at guidance scale 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub consistency: Option<Consistency>,
+}
+
+/// What a consistency-distilled bundle was distilled with (`model::train::distil`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Consistency {
+    /// The teacher's classifier-free guidance scale, baked into the weights.
+    pub guidance: f64,
+    /// Steps of the teacher's DDIM grid; few-step chains pick their timesteps on it.
+    pub grid: usize,
+    /// The teacher's weights id.
+    pub teacher: String,
 }
 
 /// Errors while loading or saving a bundle.
@@ -440,11 +455,26 @@ pub fn default_model_dir() -> PathBuf {
     if let Ok(p) = std::env::var("MPROG_MODEL") {
         return PathBuf::from(p);
     }
-    let local = PathBuf::from("models/default");
+    shipped_dir("models/default")
+}
+
+/// Where the shipped few-step model lives (the default model consistency-distilled,
+/// `models/train-distil.toml`): `$MPROG_FAST_MODEL`, else `models/fast` as
+/// [`default_model_dir`] finds `models/default`.
+pub fn fast_model_dir() -> PathBuf {
+    if let Ok(p) = std::env::var("MPROG_FAST_MODEL") {
+        return PathBuf::from(p);
+    }
+    shipped_dir("models/fast")
+}
+
+/// `rel` under the current directory when a bundle is there, else in the source tree.
+fn shipped_dir(rel: &str) -> PathBuf {
+    let local = PathBuf::from(rel);
     if local.join("manifest.json").exists() {
         return local;
     }
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/default")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use super::{MotionError, SolveError};
 use crate::features::{FEATURE_DIM, recover_from_ric};
 use crate::model::Mdm;
 use crate::model::noise::NoiseSource;
-use crate::model::sampler::{Condition, SamplerKind, sample_chain, schedule_for};
+use crate::model::sampler::{Condition, FEW_STEPS, SamplerKind, sample_chain, schedule_for};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::motion::Motion;
 use crate::scene::{DEFAULT_SPACING, Placement};
@@ -81,6 +81,18 @@ impl Ctx<'_> {
     /// `[B·P, N, 263]`.
     pub fn dims(&self) -> [usize; 3] {
         [self.motions(), self.frames, FEATURE_DIM]
+    }
+
+    /// The chain `kind` runs as on this prior: a few-step model's own chain (its
+    /// [`FEW_STEPS`] passes, unless `kind` is already one) in place of a diffusion chain.
+    pub fn chain_kind(&self, kind: SamplerKind) -> SamplerKind {
+        match (self.prior.consistency, kind) {
+            (Some(_), SamplerKind::Consistency { .. }) | (None, _) => kind,
+            (Some(c), _) => SamplerKind::Consistency {
+                steps: FEW_STEPS.min(c.grid),
+                grid: c.grid,
+            },
+        }
     }
 
     /// The encoded prompts (CFG-doubled) on `device`.
@@ -181,6 +193,26 @@ fn validate(prior: &Prior, req: &SolveRequest) -> Result<Vec<Placement>, SolveEr
     if !(req.guidance_scale.is_finite()) {
         return bad("the classifier-free guidance scale must be a finite number".into());
     }
+    if prior.consistency.is_some()
+        && let Some(why) = req.solver.few_step_refusal()
+    {
+        let takers: Vec<&str> = super::registry()
+            .iter()
+            .filter(|s| (s.make)().few_step_refusal().is_none())
+            .map(|s| s.name)
+            .collect();
+        return bad(format!(
+            "solver `{}` cannot run on a few-step (consistency-distilled) model: {why}; use {}, or a diffusion model",
+            req.solver.name(),
+            takers.join(" or ")
+        ));
+    }
+    if prior.consistency.is_none() && req.solver.needs_few_step() {
+        return bad(format!(
+            "solver `{}` runs on a few-step (consistency-distilled) model such as models/fast; pass --model models/fast, or use latent",
+            req.solver.name()
+        ));
+    }
     if let Some(edit) = &req.edit {
         if let Some(why) = req.solver.edit_refusal() {
             let takers: Vec<&str> = super::registry()
@@ -222,6 +254,7 @@ fn validate(prior: &Prior, req: &SolveRequest) -> Result<Vec<Placement>, SolveEr
 pub(crate) fn check_kind(kind: SamplerKind) -> Result<(), SolveError> {
     match kind {
         SamplerKind::Ddim(k) | SamplerKind::Ddpm(k) if (1..=DIFFUSION_STEPS).contains(&k) => Ok(()),
+        SamplerKind::Consistency { steps, grid } if (1..=grid).contains(&steps) => Ok(()),
         _ => Err(SolveError::Invalid(format!(
             "{kind:?}: a chain needs 1..={DIFFUSION_STEPS} steps"
         ))),
@@ -249,7 +282,12 @@ pub fn solve(
         people,
         frames: req.frames,
         seed: req.seed,
-        guidance_scale: req.guidance_scale,
+        // A few-step model's teacher guidance is in its weights.
+        guidance_scale: if prior.consistency.is_some() {
+            1.0
+        } else {
+            req.guidance_scale
+        },
         prompts: (0..req.samples)
             .flat_map(|_| req.prompts.iter().cloned())
             .collect(),

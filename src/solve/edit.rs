@@ -35,7 +35,9 @@ use super::take::Take;
 use crate::features::FEATURE_DIM;
 use crate::features::layout::{CONTACT, LOCAL_VEL, RIC, ROOT_Y, ROT};
 use crate::model::noise::NoiseSource;
-use crate::model::sampler::{SamplerKind, ddim_step, guided_x0, posterior_mean, schedule_for};
+use crate::model::sampler::{
+    SamplerKind, consistency_step, ddim_step, guided_x0, posterior_mean, schedule_for,
+};
 use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
 use crate::objective::MotionError;
 use crate::skeleton::{BONE_LENGTHS, NUM_JOINTS, PARENTS};
@@ -782,6 +784,7 @@ impl Ctx<'_> {
                         mean
                     }
                 }
+                SamplerKind::Consistency { .. } => consistency_step(&schedule, i, x0, &mut noise),
             };
             x = steps.after(&schedule, x, &mut noise, &self.device);
             progress(Progress {

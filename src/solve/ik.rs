@@ -153,9 +153,7 @@ impl SolverConfig for IkConfig {
             name: "ddim_steps",
             doc: "steps of the unguided DDIM sample the optimisation starts from",
             kind: KnobKind::Count,
-            get: |c| match c.sampler {
-                SamplerKind::Ddim(n) | SamplerKind::Ddpm(n) => n as f64,
-            },
+            get: |c| c.sampler.steps() as f64,
             set: |c, v| c.sampler = SamplerKind::Ddim(v as usize),
         },
         knob!(Count, "iterations", "Adam iterations on the features", iterations),

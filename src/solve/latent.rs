@@ -54,7 +54,7 @@ use super::{SolveError, host::check_shape};
 use crate::features::FEATURE_DIM;
 use super::edit::X0Hold;
 use crate::model::sampler::{Condition, ddim_step, guided_x0};
-use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule};
+use crate::model::schedule::{DIFFUSION_STEPS, NoiseSchedule, consistency_timesteps};
 use crate::model::{Denoiser, Mdm};
 use burn::prelude::*;
 use burn::tensor::Gradients;
@@ -73,6 +73,10 @@ pub enum Relax {
 pub struct LatentConfig {
     /// DDIM steps (100).
     pub ddim_steps: usize,
+    /// Steps of the chain when the prior is a few-step model (4): its consistency
+    /// timesteps, each re-noised along its own ε̂ (DDIM's rule), so x̂ = D(z) stays a
+    /// deterministic function of z, as DNO and MotionLCM's control optimise it.
+    pub fast_steps: usize,
     /// Forward passes (100; the last one's sample is returned).
     pub iterations: usize,
     /// Adam learning rate on z (0.005, constant).
@@ -91,12 +95,19 @@ pub struct LatentConfig {
     pub ref_root: f32,
     /// Weight of the same pull on the leg columns.
     pub ref_legs: f32,
+    /// Put each motion's z back on the sphere of radius √(frames · features) after every
+    /// Adam step, where Gaussian noise of that size lies (DNO keeps z there too): a
+    /// z pushed off it is noise the model never saw.
+    pub sphere: bool,
+    /// Run only on a few-step (consistency-distilled) model: `latent-fast`.
+    pub few_step: bool,
 }
 
 impl Default for LatentConfig {
     fn default() -> Self {
         LatentConfig {
             ddim_steps: 100,
+            fast_steps: crate::model::sampler::FEW_STEPS,
             iterations: 100,
             lr: 0.005,
             relax: Relax::None,
@@ -105,16 +116,38 @@ impl Default for LatentConfig {
             keep_skeleton: true,
             ref_root: 0.0,
             ref_legs: 0.0,
+            sphere: false,
+            few_step: false,
+        }
+    }
+}
+
+impl LatentConfig {
+    /// `latent-fast`: the noise of a few-step model's 4-step chain (DNO's and MotionLCM's
+    /// control by noise optimisation), 50 iterations at lr 0.05, z kept on the Gaussian
+    /// shell and the root pulled to the first sample (chosen on the main job and the PMG
+    /// tasks: book, "A few-step model").
+    pub fn fast() -> Self {
+        LatentConfig {
+            iterations: 50,
+            lr: 0.05,
+            sphere: true,
+            ref_root: 1.0,
+            few_step: true,
+            ..LatentConfig::default()
         }
     }
 }
 
 impl LatentConfig {
     fn check_settings(&self) -> Result<(), SolveError> {
-        if !(1..=DIFFUSION_STEPS).contains(&self.ddim_steps) || self.iterations == 0 {
+        if !(1..=DIFFUSION_STEPS).contains(&self.ddim_steps)
+            || !(1..=DIFFUSION_STEPS).contains(&self.fast_steps)
+            || self.iterations == 0
+        {
             return Err(SolveError::Invalid(format!(
-                "latent: {} DDIM steps and {} iterations; use 1..={DIFFUSION_STEPS} steps and ≥ 1 iteration",
-                self.ddim_steps, self.iterations
+                "latent: {} DDIM steps, {} few-model steps and {} iterations; use 1..={DIFFUSION_STEPS} steps and ≥ 1 iteration",
+                self.ddim_steps, self.fast_steps, self.iterations
             )));
         }
         if !(self.lr.is_finite() && self.lr >= 0.0 && self.relax_lr.is_finite()) {
@@ -253,6 +286,9 @@ fn run(
         let gz = chain.noise_gradient(forward, &grads, z.len());
         ensure_finite(&gz, "latent", "gradient", at)?;
         adam.step(&mut z, &gz);
+        if cfg.sphere {
+            onto_sphere(&mut z, m);
+        }
         if relax {
             let g = match &rt {
                 Some(r) => rigid_gradient(r, &grads, m),
@@ -273,6 +309,18 @@ fn run(
         cleaned: false,
         trace,
     })
+}
+
+/// Scales each of the `motions` equal parts of `z` to norm √(its length).
+fn onto_sphere(z: &mut [f32], motions: usize) {
+    let len = z.len() / motions.max(1);
+    for part in z.chunks_exact_mut(len) {
+        let norm = part.iter().map(|v| (*v as f64).powi(2)).sum::<f64>().sqrt();
+        if norm > 0.0 {
+            let k = ((len as f64).sqrt() / norm) as f32;
+            part.iter_mut().for_each(|v| *v *= k);
+        }
+    }
 }
 
 /// The rigid moves `[yaw; x; z] × motions` as placements, one per motion.
@@ -344,7 +392,11 @@ impl<'a, 'c> Chain<'a, 'c> {
         let ad = ctx.device.clone().autodiff();
         let model = frozen(ctx.prior.model, &ad);
         let cond = ctx.condition(&ad);
-        let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS).respaced(cfg.ddim_steps);
+        let base = NoiseSchedule::cosine(DIFFUSION_STEPS);
+        let schedule = match ctx.prior.consistency {
+            Some(c) => base.at(&consistency_timesteps(c.grid, cfg.fast_steps)),
+            None => base.respaced(cfg.ddim_steps),
+        };
         Chain {
             ctx,
             checkpoint: cfg.checkpoint,
@@ -526,15 +578,23 @@ impl<'a, 'c> Chain<'a, 'c> {
 }
 
 /// `latent`, for [`super::registry`].
-pub const SPECS: &[SolverSpec] = &[SolverSpec {
-    name: "latent",
-    summary: "the initial noise z of a DDIM chain, Adam through the whole chain (PMG)",
-    make: || Solver::new(LatentConfig::default()),
-}];
+pub const SPECS: &[SolverSpec] = &[
+    SolverSpec {
+        name: "latent",
+        summary: "the initial noise z of a DDIM chain, Adam through the whole chain (PMG)",
+        make: || Solver::new(LatentConfig::default()),
+    },
+    SolverSpec {
+        name: "latent-fast",
+        summary: "latent through a few-step model's 4-step chain (DNO, MotionLCM; models/fast)",
+        make: || Solver::new(LatentConfig::fast()),
+    },
+];
 
 impl SolverConfig for LatentConfig {
     const KNOBS: &'static [Knob<Self>] = &[
         knob!(Count, "ddim_steps", "length of the DDIM chain the gradient goes through", ddim_steps),
+        knob!(Count, "fast_steps", "length of the chain on a few-step (consistency-distilled) model", fast_steps),
         knob!(Count, "iterations", "Adam iterations on z (the last forward pass is returned)", iterations),
         knob!(Real, "lr", "Adam's learning rate on z", lr),
         Knob {
@@ -561,10 +621,16 @@ impl SolverConfig for LatentConfig {
         ),
         knob!(Real, "ref_root", "weight of PMG's pull of the root columns (yaw and XZ velocity, height) towards the iteration-0 sample; 0: off", ref_root),
         knob!(Real, "ref_legs", "weight of the same pull on the legs' columns (hips, knees, ankles, toes; foot contacts); 0: off", ref_legs),
+        knob!(
+            Flag("off", "on the sphere"),
+            "sphere",
+            "1: keep each motion's z on the Gaussian shell (norm √(frames·263)) after every step",
+            sphere
+        ),
     ];
 
     fn name(&self) -> &'static str {
-        "latent"
+        if self.few_step { "latent-fast" } else { "latent" }
     }
 
     fn unguided(&self) -> SamplerKind {
@@ -580,5 +646,13 @@ impl SolverConfig for LatentConfig {
     }
     fn edit_refusal(&self) -> Option<&'static str> {
         None
+    }
+
+    fn few_step_refusal(&self) -> Option<&'static str> {
+        None
+    }
+
+    fn needs_few_step(&self) -> bool {
+        self.few_step
     }
 }

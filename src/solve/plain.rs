@@ -26,15 +26,8 @@ impl SolverConfig for PlainConfig {
         name: "steps",
         doc: "steps of the chain (DDPM by default)",
         kind: KnobKind::Count,
-        get: |c| match c.sampler {
-            SamplerKind::Ddim(n) | SamplerKind::Ddpm(n) => n as f64,
-        },
-        set: |c, v| {
-            c.sampler = match c.sampler {
-                SamplerKind::Ddim(_) => SamplerKind::Ddim(v as usize),
-                SamplerKind::Ddpm(_) => SamplerKind::Ddpm(v as usize),
-            }
-        },
+        get: |c| c.sampler.steps() as f64,
+        set: |c, v| c.sampler = c.sampler.with_steps(v as usize),
     }];
 
     fn name(&self) -> &'static str {
@@ -51,7 +44,7 @@ impl SolverConfig for PlainConfig {
 
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {
         Ok(Outcome {
-            x: host(ctx.sample_edited(self.sampler, progress)),
+            x: host(ctx.sample_edited(ctx.chain_kind(self.sampler), progress)),
             relax: None,
             cleaned: false,
             trace: Vec::new(),
@@ -59,6 +52,10 @@ impl SolverConfig for PlainConfig {
     }
 
     fn edit_refusal(&self) -> Option<&'static str> {
+        None
+    }
+
+    fn few_step_refusal(&self) -> Option<&'static str> {
         None
     }
 }

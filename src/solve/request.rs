@@ -5,6 +5,7 @@ use super::edit::Edit;
 use super::solver::Solver;
 use crate::model::control::ControlNet;
 use crate::model::prompt::PromptEncoder;
+use crate::model::weights::Consistency;
 use crate::model::{Mdm, ModelBundle};
 use crate::motion::Motion;
 use crate::scene::Placement;
@@ -24,6 +25,9 @@ pub struct Prior<'a> {
     pub max_frames: usize,
     /// The realism ControlNet trained on this denoiser, when the bundle has one.
     pub control: Option<&'a ControlNet>,
+    /// Set when the denoiser is a consistency-distilled few-step model: solvers that can
+    /// run on one use its chain ([`super::driver::Ctx::chain_kind`]) at guidance 1.
+    pub consistency: Option<&'a Consistency>,
 }
 
 impl<'a> Prior<'a> {
@@ -36,6 +40,7 @@ impl<'a> Prior<'a> {
             std: &bundle.std,
             max_frames: bundle.config.max_frames,
             control: None,
+            consistency: bundle.manifest.consistency.as_ref(),
         }
     }
 

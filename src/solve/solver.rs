@@ -35,6 +35,17 @@ pub trait SolverConfig: Any + Clone + fmt::Debug + PartialEq + Send + Sync {
     fn edit_refusal(&self) -> Option<&'static str> {
         Some("it only starts from noise")
     }
+
+    /// Why it cannot run on a consistency-distilled few-step model, or `None` when it can
+    /// (its chain then comes from [`Ctx::chain_kind`] or the prior's grid).
+    fn few_step_refusal(&self) -> Option<&'static str> {
+        Some("it steers a diffusion chain step by step")
+    }
+
+    /// True when it runs only on a few-step model.
+    fn needs_few_step(&self) -> bool {
+        false
+    }
 }
 
 /// A registered solver: its name, a line on what it moves, and its default settings.
@@ -137,6 +148,25 @@ impl Solver {
         self.0.edit_refusal()
     }
 
+    /// Why it cannot run on a few-step model, or `None` when it can.
+    pub fn few_step_refusal(&self) -> Option<&'static str> {
+        self.0.few_step_refusal()
+    }
+
+    /// True when it runs only on a few-step model.
+    pub fn needs_few_step(&self) -> bool {
+        self.0.needs_few_step()
+    }
+
+    /// Whether it can run on a model that is (`few_step`) or is not a few-step one.
+    pub fn runs_on(&self, few_step: bool) -> bool {
+        if few_step {
+            self.few_step_refusal().is_none()
+        } else {
+            !self.needs_few_step()
+        }
+    }
+
     pub(crate) fn run(
         &self,
         ctx: &Ctx,
@@ -173,6 +203,8 @@ trait DynSolver: Send + Sync {
     fn set_knob(&mut self, name: &str, value: f64) -> Result<(), String>;
     fn validate(&self) -> Result<(), SolveError>;
     fn edit_refusal(&self) -> Option<&'static str>;
+    fn few_step_refusal(&self) -> Option<&'static str>;
+    fn needs_few_step(&self) -> bool;
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError>;
     fn clone_box(&self) -> Box<dyn DynSolver>;
     fn eq_dyn(&self, other: &dyn Any) -> bool;
@@ -221,6 +253,14 @@ impl<C: SolverConfig> DynSolver for C {
 
     fn edit_refusal(&self) -> Option<&'static str> {
         SolverConfig::edit_refusal(self)
+    }
+
+    fn few_step_refusal(&self) -> Option<&'static str> {
+        SolverConfig::few_step_refusal(self)
+    }
+
+    fn needs_few_step(&self) -> bool {
+        SolverConfig::needs_few_step(self)
     }
 
     fn run(&self, ctx: &Ctx, progress: &mut dyn FnMut(Progress)) -> Result<Outcome, SolveError> {

@@ -9,8 +9,8 @@ use crate::model::config::{ModelConfig, TextEncoderKind, TrainConfig};
 use crate::model::denoiser::Mdm;
 use crate::model::prompt::PromptEncoder;
 use crate::model::weights::{
-    BUNDLE_VERSION, Manifest, ModelBundle, model_from_safetensors, model_to_safetensors,
-    save_bundle_parts, save_trained_actions,
+    BUNDLE_VERSION, Consistency, Manifest, ModelBundle, model_from_safetensors,
+    model_to_safetensors, save_bundle_parts, save_trained_actions,
 };
 use burn::module::Module;
 use burn::optim::{AdamWConfig, ModuleOptimizer, grad_clipping::GradientClippingConfig};
@@ -202,8 +202,15 @@ impl TrainRun<'_> {
         let manifest = Manifest {
             version: BUNDLE_VERSION,
             weights_id: format!(
-                "mdm-{}x{}-step{}",
-                self.config.model.d_model, self.config.model.layers, ck.state.step
+                "{}-{}x{}-step{}",
+                if self.config.distil.is_some() {
+                    "lcm"
+                } else {
+                    "mdm"
+                },
+                self.config.model.d_model,
+                self.config.model.layers,
+                ck.state.step
             ),
             steps: ck.state.step,
             train_seconds: ck.state.seconds,
@@ -213,6 +220,13 @@ impl TrainRun<'_> {
                 TrainText::Sentences { prompts, .. } => Some(prompts.encoder.id().to_string()),
             },
             control_id: None,
+            consistency: self.config.distil.as_ref().map(|d| Consistency {
+                guidance: d.guidance,
+                grid: d.grid,
+                teacher: Manifest::read(&Path::new(&d.teacher).join("manifest.json"))
+                    .map(|m| m.weights_id)
+                    .unwrap_or_else(|_| d.teacher.clone()),
+            }),
         };
         save_bundle_parts(
             &bundle,

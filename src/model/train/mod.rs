@@ -24,6 +24,7 @@
 //! | `text.rs` | the run's text side: a vocabulary or the embedded captions |
 //! | `log.rs` | `loss.csv` and `val.csv` |
 //! | `control.rs` | a ControlNet trained on a frozen base |
+//! | `distil.rs` | consistency distillation of a teacher bundle (`[distil]` in the config) |
 //!
 //! A checkpoint is written whole into `ckpt.new/` and then swapped in by renames, so a
 //! kill at any moment leaves either the old or the new checkpoint complete.
@@ -31,6 +32,7 @@
 pub mod augment;
 mod checkpoint;
 pub mod control;
+mod distil;
 mod log;
 mod losses;
 pub mod paraphrase;
@@ -51,6 +53,7 @@ use burn::module::Module;
 use burn::optim::GradientsParams;
 use burn::prelude::*;
 use checkpoint::Checkpoint;
+use distil::{Teacher, distil_loss};
 use log::append;
 use losses::batch_loss;
 use serde::{Deserialize, Serialize};
@@ -169,6 +172,7 @@ impl TrainRun<'_> {
         ema: &Mdm,
         text: &TrainText,
         schedule: &NoiseSchedule,
+        teacher: Option<&Teacher>,
         device: &Device,
     ) -> Option<f64> {
         let clips: Vec<&ClipInfo> = self.data.clips(Split::Val).collect();
@@ -186,7 +190,11 @@ impl TrainRun<'_> {
             // Fixed "steps" far beyond any real step keep validation batches constant.
             let batch = draw_batch(self.data, &clips, &cfg, usize::MAX - r);
             let none = GeometricLosses::default();
-            let loss = batch_loss(ema, schedule, &batch, text, &none, device);
+            let loss = match teacher {
+                // The EMA is both student and target: how far it is from consistent.
+                Some(t) => distil_loss(ema, ema, t, schedule, &batch, text, device, device),
+                None => batch_loss(ema, schedule, &batch, text, &none, device),
+            };
             total += loss.into_scalar::<f32>() as f64;
         }
         Some(total / rounds as f64)
@@ -210,6 +218,7 @@ impl TrainRun<'_> {
         let device = plain.clone().autodiff();
         let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
         let mut ck = self.load_or_init(&text, &device, &plain)?;
+        let teacher = self.teacher(&plain)?;
         let geometric = GeometricLosses::new(cfg, &self.data.mean, &self.data.std, &device);
         let stop_at = match self.max_steps_now {
             Some(n) => (ck.state.step + n).min(cfg.steps),
@@ -228,7 +237,12 @@ impl TrainRun<'_> {
             if let Some(a) = &augment {
                 a.apply(&mut batch.captions, cfg.seed, step);
             }
-            let loss = batch_loss(&ck.model, &schedule, &batch, &text, &geometric, &device);
+            let loss = match &teacher {
+                Some(t) => distil_loss(
+                    &ck.model, &ck.ema, t, &schedule, &batch, &text, &device, &plain,
+                ),
+                None => batch_loss(&ck.model, &schedule, &batch, &text, &geometric, &device),
+            };
             let value = loss.clone().into_scalar::<f32>();
             if !value.is_finite() {
                 return Err(TrainError::Diverged { step, loss: value });
@@ -255,6 +269,7 @@ impl TrainRun<'_> {
                     &mut pending,
                     &text,
                     &schedule,
+                    teacher.as_ref(),
                     &plain,
                 )?;
                 saved_at = ck.state.step;
@@ -269,13 +284,37 @@ impl TrainRun<'_> {
                 &mut pending,
                 &text,
                 &schedule,
+                teacher.as_ref(),
                 &plain,
             )?;
         }
         Ok(ck.state)
     }
 
+    /// The frozen teacher of a distillation run (None for a plain run).
+    fn teacher(&self, plain: &Device) -> Result<Option<Teacher>, TrainError> {
+        let Some(cfg) = &self.config.distil else {
+            return Ok(None);
+        };
+        let path = PathBuf::from(&cfg.teacher);
+        let bundle = crate::model::weights::ModelBundle::load(&path, plain)?;
+        if bundle.config != self.config.model {
+            return Err(TrainError::Invalid(format!(
+                "the teacher {} has another denoiser config than the run's [model]",
+                path.display()
+            )));
+        }
+        if bundle.manifest.consistency.is_some() {
+            return Err(TrainError::Invalid(format!(
+                "the teacher {} is itself a few-step model; distil from a diffusion model",
+                path.display()
+            )));
+        }
+        Ok(Some(Teacher::new(bundle.model, cfg)))
+    }
+
     /// Validates, appends the loss rows and saves the checkpoint.
+    #[allow(clippy::too_many_arguments)]
     fn checkpoint(
         &self,
         ck: &mut Checkpoint,
@@ -283,11 +322,12 @@ impl TrainRun<'_> {
         pending: &mut String,
         text: &TrainText,
         schedule: &NoiseSchedule,
+        teacher: Option<&Teacher>,
         plain: &Device,
     ) -> Result<(), TrainError> {
         ck.state.recent_loss = since_ckpt.0 / since_ckpt.1.max(1) as f64;
         *since_ckpt = (0.0, 0);
-        ck.state.val_loss = self.validate(&ck.ema, text, schedule, plain);
+        ck.state.val_loss = self.validate(&ck.ema, text, schedule, teacher, plain);
         append(
             &self.out.join("loss.csv"),
             "step,loss,lr,seconds\n",
