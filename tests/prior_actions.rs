@@ -9,6 +9,7 @@
 use burn::prelude::*;
 use mprog::metrics::actions::{actions_table, measure_actions};
 use mprog::model::ModelBundle;
+use mprog::model::sampler::SamplerKind;
 use mprog::model::weights::default_model_dir;
 
 #[test]
@@ -23,7 +24,7 @@ fn the_prior_performs_the_wider_actions() {
             return;
         }
     };
-    let rows = measure_actions(&bundle, &device, None, 2.5).unwrap();
+    let rows = measure_actions(&bundle, &device, None, SamplerKind::Ddim(50), 2.5).unwrap();
     let table = actions_table(&rows);
     println!("model {}\n\n{table}", bundle.manifest.weights_id);
     let failed: Vec<&str> = rows

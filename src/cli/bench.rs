@@ -46,9 +46,9 @@ pub struct ActionBenchArgs {
     /// the model's length prior, the walk 6 s).
     #[arg(long)]
     seconds: Option<f32>,
-    /// Classifier-free guidance scale (`mprog gen`'s default).
-    #[arg(long, default_value_t = 2.5, value_parser = super::parse_guidance, allow_hyphen_values = true)]
-    guidance: f32,
+    /// Classifier-free guidance scale (`mprog gen`'s default: 2.5, 1 for a few-step model).
+    #[arg(long, value_parser = super::parse_guidance, allow_hyphen_values = true)]
+    guidance: Option<f32>,
 }
 
 fn bench_actions(args: ActionBenchArgs) -> Result<()> {
@@ -62,18 +62,21 @@ fn bench_actions(args: ActionBenchArgs) -> Result<()> {
     if let Some(s) = args.seconds {
         super::generate::seconds_to_frames(s)?;
     }
+    // `gen`'s chain for this bundle: DDIM 50, or a few-step model's own.
+    let (sampler, guidance) =
+        super::generate::sampling_for(&bundle.manifest, None, None, args.guidance)?;
     let rows =
-        mprog::metrics::actions::measure_actions(&bundle, &device, args.seconds, args.guidance)
+        mprog::metrics::actions::measure_actions(&bundle, &device, args.seconds, sampler, guidance)
             .into_diagnostic()?;
     let length = match args.seconds {
         Some(s) => format!("{s} s"),
         None => "each prompt as long as `gen` makes it".to_string(),
     };
     println!(
-        "model {} ({}): {length}, DDIM 50, guidance {}, no cleanup; heights above the motion's lowest foot joint\n",
+        "model {} ({}): {length}, {}, guidance {guidance}, no cleanup; heights above the motion's lowest foot joint\n",
         bundle.manifest.weights_id,
         dir.display(),
-        args.guidance
+        mprog::metrics::table::sampler_name(sampler),
     );
     print!("{}", mprog::metrics::actions::actions_table(&rows));
     Ok(())

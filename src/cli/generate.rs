@@ -138,11 +138,11 @@ pub fn sampling_for(
     guidance: Option<f32>,
 ) -> Result<(SamplerKind, f32)> {
     check_sampler_name(name)?;
+    let (default_kind, default_scale) = mprog::model::sampler::default_chain(bundle);
     let kind = match (name, &bundle.consistency) {
-        (None | Some("lcm"), Some(c)) => SamplerKind::Consistency {
-            steps: steps.unwrap_or(DEFAULT_CONSISTENCY_STEPS).min(c.grid),
-            grid: c.grid,
-        },
+        (None | Some("lcm"), Some(c)) => {
+            default_kind.with_steps(steps.unwrap_or(default_kind.steps()).min(c.grid))
+        }
         (Some("lcm"), None) => {
             return Err(miette::miette!(
                 help =
@@ -154,19 +154,8 @@ pub fn sampling_for(
         (Some("ddpm"), _) => SamplerKind::Ddpm(steps.unwrap_or(1000)),
         _ => SamplerKind::Ddim(steps.unwrap_or(50)),
     };
-    let scale = match (&bundle.consistency, guidance) {
-        (_, Some(g)) => g,
-        (Some(_), None) => 1.0,
-        (None, None) => DEFAULT_GUIDANCE,
-    };
-    Ok((kind, scale))
+    Ok((kind, guidance.unwrap_or(default_scale)))
 }
-
-/// Classifier-free guidance scale of a diffusion bundle when `--guidance` is not given.
-pub const DEFAULT_GUIDANCE: f32 = 2.5;
-
-/// Steps of a consistency model's chain when `--steps` is not given.
-pub const DEFAULT_CONSISTENCY_STEPS: usize = mprog::model::sampler::FEW_STEPS;
 
 /// A `gen` longer than the model makes: the unguided chain window by window
 /// ([`mprog::solve::long`]), each window continuing the last second of the one before.

@@ -753,13 +753,14 @@ impl ActionRow {
     }
 }
 
-/// Generates every case with seeds 1 and 2 at classifier-free guidance `guidance` and
-/// measures it; `seconds` pins every case's length (else each has its own, see the
-/// module's notes).
+/// Generates every case with seeds 1 and 2 on the chain `sampler` at classifier-free
+/// guidance `guidance` and measures it; `seconds` pins every case's length (else each has
+/// its own, see the module's notes).
 pub fn measure_actions(
     bundle: &ModelBundle,
     device: &Device,
     seconds: Option<f32>,
+    sampler: SamplerKind,
     guidance: f32,
 ) -> Result<Vec<ActionRow>, GenerateError> {
     CASES
@@ -778,7 +779,7 @@ pub fn measure_actions(
                     prompts: vec![case.prompt.to_string()],
                     frames,
                     seed,
-                    sampler: SamplerKind::Ddim(50),
+                    sampler,
                     guidance_scale: guidance,
                     mirror_average: false,
                 };

@@ -5,7 +5,8 @@ use super::report::{EvalReport, LabelStats};
 use crate::model::sampler::SamplerKind;
 use std::fmt::Write;
 
-fn sampler_name(s: SamplerKind) -> String {
+/// A chain as the tables name it ("DDIM 50").
+pub fn sampler_name(s: SamplerKind) -> String {
     match s {
         SamplerKind::Ddim(n) => format!("DDIM {n}"),
         SamplerKind::Ddpm(n) => format!("DDPM {n}"),

@@ -28,6 +28,21 @@ pub enum SamplerKind {
 /// default: more steps add little).
 pub const FEW_STEPS: usize = 4;
 
+/// `gen`'s chain and guidance scale for a bundle: DDIM 50 at 2.5 for a diffusion model,
+/// its own [`FEW_STEPS`]-step chain at 1 for a consistency-distilled one.
+pub fn default_chain(manifest: &super::weights::Manifest) -> (SamplerKind, f32) {
+    match &manifest.consistency {
+        Some(c) => (
+            SamplerKind::Consistency {
+                steps: FEW_STEPS.min(c.grid),
+                grid: c.grid,
+            },
+            1.0,
+        ),
+        None => (SamplerKind::Ddim(50), 2.5),
+    }
+}
+
 impl SamplerKind {
     /// Steps of the chain.
     pub fn steps(self) -> usize {

@@ -16,7 +16,7 @@ use crate::formats::{LoadedMotion, OutputJob, read_motion, write_outputs};
 use crate::lang::{Diagnostics, Program, Severity, compile};
 use crate::model::ModelBundle;
 use crate::model::generate::{GenerateRequest, generate};
-use crate::model::sampler::SamplerKind;
+use crate::model::sampler::default_chain;
 use crate::motion::Motion;
 use crate::skeleton::FPS;
 use crate::solve::cleanup::{FootCleanup, clean_generated};
@@ -275,22 +275,26 @@ impl Session {
 
     fn gen_motion(&mut self, prompt: &str, seconds: f32, seed: u64) -> Reply {
         let frames = (seconds * FPS).round() as usize;
-        let req = GenerateRequest {
-            prompts: vec![prompt.to_string()],
-            frames,
-            seed,
-            sampler: SamplerKind::Ddim(50),
-            guidance_scale: 2.5,
-            mirror_average: false,
-        };
         let device = self.device.clone();
         let out = match self.bundle() {
             Err(e) => return Reply::error(e),
-            Ok(bundle) => generate(bundle, &req, &device, |_, _| {}).and_then(|mut g| {
-                // As `mprog gen` does by default.
-                clean_generated(&mut g, frames, &FootCleanup::default())?;
-                Ok(g)
-            }),
+            Ok(bundle) => {
+                // `mprog gen`'s chain for this model (a few-step model's own).
+                let (sampler, guidance_scale) = default_chain(&bundle.manifest);
+                let req = GenerateRequest {
+                    prompts: vec![prompt.to_string()],
+                    frames,
+                    seed,
+                    sampler,
+                    guidance_scale,
+                    mirror_average: false,
+                };
+                generate(bundle, &req, &device, |_, _| {}).and_then(|mut g| {
+                    // As `mprog gen` does by default.
+                    clean_generated(&mut g, frames, &FootCleanup::default())?;
+                    Ok(g)
+                })
+            }
         };
         match out {
             Err(e) => Reply::error(format!("generation failed: {e}")),

@@ -124,15 +124,15 @@ impl Default for LatentConfig {
 
 impl LatentConfig {
     /// `latent-fast`: the noise of a few-step model's 4-step chain (DNO's and MotionLCM's
-    /// control by noise optimisation), 50 iterations at lr 0.05, z kept on the Gaussian
-    /// shell and the root pulled to the first sample (chosen on the main job and the PMG
-    /// tasks: book, "A few-step model").
+    /// control by noise optimisation), 100 iterations at lr 0.05, z kept on the Gaussian
+    /// shell and the root pulled lightly to the first sample (chosen on the main job and
+    /// the PMG tasks: book, "A few-step model").
     pub fn fast() -> Self {
         LatentConfig {
-            iterations: 50,
+            iterations: 100,
             lr: 0.05,
             sphere: true,
-            ref_root: 1.0,
+            ref_root: 0.3,
             few_step: true,
             ..LatentConfig::default()
         }

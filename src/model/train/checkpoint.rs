@@ -70,6 +70,8 @@ impl TrainRun<'_> {
                     side_input: bundle.config.side_input || cfg.model.side_input,
                     // When the outer taps read is the run's choice; it has no weights.
                     skip_taps_below: cfg.model.skip_taps_below,
+                    // Dropout has no weights either: a fine-tune may change it.
+                    dropout: cfg.model.dropout,
                     ..bundle.config.clone()
                 };
                 let weights = init.join("model.safetensors");
@@ -105,7 +107,11 @@ impl TrainRun<'_> {
                         )));
                     }
                     // Load into a fresh training module so its parameters track gradients.
-                    let fresh = Mdm::new(&bundle.config, vocab_size, train_dev);
+                    let shape = ModelConfig {
+                        dropout: cfg.model.dropout,
+                        ..bundle.config.clone()
+                    };
+                    let fresh = Mdm::new(&shape, vocab_size, train_dev);
                     let model = model_from_safetensors(fresh, bytes, half)
                         .map_err(|e| file_err(&weights, e))?;
                     (model, bundle.model)

@@ -298,7 +298,12 @@ impl TrainRun<'_> {
         };
         let path = PathBuf::from(&cfg.teacher);
         let bundle = crate::model::weights::ModelBundle::load(&path, plain)?;
-        if bundle.config != self.config.model {
+        // Dropout has no weights (the run may train without it, the teacher never uses it).
+        let run_shape = crate::model::config::ModelConfig {
+            dropout: bundle.config.dropout,
+            ..self.config.model.clone()
+        };
+        if bundle.config != run_shape {
             return Err(TrainError::Invalid(format!(
                 "the teacher {} has another denoiser config than the run's [model]",
                 path.display()
