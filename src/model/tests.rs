@@ -543,6 +543,8 @@ fn distillation_fits_a_student_to_its_teacher_and_marks_the_bundle() {
     let distil = TrainConfig {
         learning_rate: 1e-3,
         ema_decay: 0.95,
+        // The student's bone term runs too.
+        bone_loss: 1e-4,
         distil: Some(DistilConfig {
             teacher: bundle_dir.display().to_string(),
             guidance: 2.5,

@@ -12,7 +12,7 @@
 //! text (`cond_drop`); for those the teacher's unguided x̂0 is the target, so the student
 //! keeps an unconditional pass.
 
-use super::losses::{q_sample, to_device};
+use super::losses::{BoneLoss, q_sample, to_device};
 use super::text::TrainText;
 use crate::model::batch::HostBatch;
 use crate::model::config::DistilConfig;
@@ -142,7 +142,10 @@ fn pseudo_huber(pred: Tensor<3>, target: Tensor<3>, valid: Tensor<3>, c: f32) ->
 }
 
 /// The distillation loss of one batch. `student` lives on `train_dev` (with autodiff in
-/// training, the plain device in validation); the teacher and `target` on `plain`.
+/// training, the plain device in validation); the teacher and `target` on `plain`. With
+/// `bones` (the run's `bone_loss`, on `train_dev`) the student's output also pays for
+/// bones off the skeleton's lengths: a consistency model's x̂0 is a final sample at every
+/// t, not the blurred mean a diffusion model's is at high t.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn distil_loss(
     student: &Mdm,
@@ -151,6 +154,7 @@ pub(super) fn distil_loss(
     schedule: &NoiseSchedule,
     batch: &HostBatch,
     text: &TrainText,
+    bones: Option<&BoneLoss>,
     train_dev: &Device,
     plain: &Device,
 ) -> Tensor<1> {
@@ -172,7 +176,11 @@ pub(super) fn distil_loss(
     s_input.x_t = x_hi.clone();
     s_input.timesteps = hi.clone();
     let pred = boundary(x_hi, student.predict_x0(&s_input), &hi);
-    pseudo_huber(pred, goal, valid, teacher.huber_c)
+    let loss = pseudo_huber(pred.clone(), goal, valid.clone(), teacher.huber_c);
+    match bones {
+        Some(b) => loss + b.term(pred, valid) * b.weight,
+        None => loss,
+    }
 }
 
 #[cfg(test)]

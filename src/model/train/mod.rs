@@ -192,7 +192,7 @@ impl TrainRun<'_> {
             let none = GeometricLosses::default();
             let loss = match teacher {
                 // The EMA is both student and target: how far it is from consistent.
-                Some(t) => distil_loss(ema, ema, t, schedule, &batch, text, device, device),
+                Some(t) => distil_loss(ema, ema, t, schedule, &batch, text, None, device, device),
                 None => batch_loss(ema, schedule, &batch, text, &none, device),
             };
             total += loss.into_scalar::<f32>() as f64;
@@ -239,7 +239,15 @@ impl TrainRun<'_> {
             }
             let loss = match &teacher {
                 Some(t) => distil_loss(
-                    &ck.model, &ck.ema, t, &schedule, &batch, &text, &device, &plain,
+                    &ck.model,
+                    &ck.ema,
+                    t,
+                    &schedule,
+                    &batch,
+                    &text,
+                    geometric.bones.as_ref(),
+                    &device,
+                    &plain,
                 ),
                 None => batch_loss(&ck.model, &schedule, &batch, &text, &geometric, &device),
             };
