@@ -174,6 +174,16 @@ pub(crate) fn ensure_finite(
     }
 }
 
+/// The registered solvers that `accepts`, as "a or b" for a refusal's hint.
+fn takers(accepts: impl Fn(&super::Solver) -> bool) -> String {
+    super::registry()
+        .iter()
+        .filter(|s| accepts(&(s.make)()))
+        .map(|s| s.name)
+        .collect::<Vec<_>>()
+        .join(" or ")
+}
+
 fn validate(prior: &Prior, req: &SolveRequest) -> Result<Vec<Placement>, SolveError> {
     let bad = |m: String| Err(SolveError::Invalid(m));
     if req.prompts.is_empty() {
@@ -196,15 +206,10 @@ fn validate(prior: &Prior, req: &SolveRequest) -> Result<Vec<Placement>, SolveEr
     if prior.consistency.is_some()
         && let Some(why) = req.solver.few_step_refusal()
     {
-        let takers: Vec<&str> = super::registry()
-            .iter()
-            .filter(|s| (s.make)().few_step_refusal().is_none())
-            .map(|s| s.name)
-            .collect();
         return bad(format!(
             "solver `{}` cannot run on a few-step (consistency-distilled) model: {why}; use {}, or a diffusion model",
             req.solver.name(),
-            takers.join(" or ")
+            takers(|s| s.few_step_refusal().is_none())
         ));
     }
     if prior.consistency.is_none() && req.solver.needs_few_step() {
@@ -215,15 +220,10 @@ fn validate(prior: &Prior, req: &SolveRequest) -> Result<Vec<Placement>, SolveEr
     }
     if let Some(edit) = &req.edit {
         if let Some(why) = req.solver.edit_refusal() {
-            let takers: Vec<&str> = super::registry()
-                .iter()
-                .filter(|s| (s.make)().edit_refusal().is_none())
-                .map(|s| s.name)
-                .collect();
             return bad(format!(
                 "solver `{}` cannot edit a take: {why}; use {}",
                 req.solver.name(),
-                takers.join(" or ")
+                takers(|s| s.edit_refusal().is_none())
             ));
         }
         edit.check(req.prompts.len(), req.frames)?;
