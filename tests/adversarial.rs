@@ -177,6 +177,7 @@ fn tiny_config() -> ModelConfig {
         skip_taps: 1,
         skip_taps_below: None,
         side_input: false,
+        text_control: None,
     }
 }
 

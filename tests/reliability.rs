@@ -47,6 +47,7 @@ fn model_config(d_model: usize, layers: usize) -> ModelConfig {
         skip_taps: 1,
         skip_taps_below: None,
         side_input: false,
+        text_control: None,
     }
 }
 

@@ -32,6 +32,9 @@ pub struct HostBatch {
     pub noise_seed: u64,
     /// Per-dimension noise added to the sentence vectors (`TrainConfig::text_noise`).
     pub text_noise: f64,
+    /// 1 keeps the sentence vector for a text ControlNet's AdaIN, 0 empties it
+    /// (`TrainConfig::eos_drop`); empty without it.
+    pub eos_keep: Vec<f32>,
 }
 
 /// Feature columns that are motion to the next frame (zero while a pose is held).
@@ -167,6 +170,15 @@ pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: us
             }
         })
         .collect();
+    let noise_seed = rng.random();
+    // Drawn after everything else, so runs without it draw what they always drew.
+    let eos_keep = if cfg.eos_drop > 0.0 {
+        (0..b)
+            .map(|_| f32::from(u8::from(rng.random::<f64>() >= cfg.eos_drop)))
+            .collect()
+    } else {
+        Vec::new()
+    };
     HostBatch {
         x0,
         padding,
@@ -174,8 +186,9 @@ pub fn draw_batch(ds: &Dataset, clips: &[&ClipInfo], cfg: &TrainConfig, step: us
         captions,
         timesteps,
         keep_text,
-        noise_seed: rng.random(),
+        noise_seed,
         text_noise: cfg.text_noise,
+        eos_keep,
     }
 }
 

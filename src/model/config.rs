@@ -56,6 +56,12 @@ pub struct ModelConfig {
     /// under mirroring. Bundles without the field have none.
     #[serde(default, skip_serializing_if = "is_false")]
     pub side_input: bool,
+    /// OMG's text ControlNet (`model::moc`, sentence encoders only): the text enters only
+    /// through trainable layer copies and Mixture-of-Controllers blocks reading the
+    /// prompt's token states, over a prior trained without text. A run with it trains
+    /// only the ControlNet. Bundles without the field have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub text_control: Option<crate::model::moc::MocConfig>,
 }
 
 /// The text encoder of a denoiser.
@@ -112,6 +118,7 @@ impl Default for ModelConfig {
             skip_taps: 1,
             skip_taps_below: None,
             side_input: false,
+            text_control: None,
         }
     }
 }
@@ -224,6 +231,11 @@ pub struct TrainConfig {
     /// after: an action learnt only at its clip's length did not happen in a longer motion.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub hold_pad: f64,
+    /// Probability that a sample's sentence vector is replaced by the empty one for the
+    /// text ControlNet's AdaIN (OMG drops its `<eos>` token half the time, so the
+    /// per-token experts learn to carry the text alone).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub eos_drop: f64,
     /// Seed of the data order and noise.
     pub seed: u64,
     /// Consistency distillation of a teacher bundle into a few-step model, instead of
@@ -316,6 +328,7 @@ impl Default for TrainConfig {
             paraphrase_holdout: None,
             text_noise: 0.0,
             hold_pad: 0.0,
+            eos_drop: 0.0,
             seed: 1,
             distil: None,
         }
@@ -378,6 +391,12 @@ impl ModelConfig {
         if self.side_input && self.text_encoder != TextEncoderKind::Sentence {
             return Err("`side_input` needs `text_encoder = \"minilm\"`".into());
         }
+        if let Some(c) = &self.text_control {
+            c.check()?;
+            if self.text_encoder != TextEncoderKind::Sentence {
+                return Err("`text_control` needs `text_encoder = \"minilm\"`".into());
+            }
+        }
         if self.skip_taps > 1 && !self.input_skip {
             return Err("`skip_taps` above 1 needs `input_skip = true`".into());
         }
@@ -434,6 +453,13 @@ impl TrainConfig {
         fraction("paraphrase_prob", self.paraphrase_prob, false)?;
         fraction("paraphrase_min_cos", self.paraphrase_min_cos, false)?;
         fraction("hold_pad", self.hold_pad, false)?;
+        fraction("eos_drop", self.eos_drop, false)?;
+        if self.eos_drop > 0.0 && self.model.text_control.is_none() {
+            return Err("`eos_drop` needs a `[model.text_control]`".into());
+        }
+        if self.model.text_control.is_some() && self.distil.is_some() {
+            return Err("a run trains a text ControlNet or distils, not both".into());
+        }
         in_range(
             "paraphrases_per_caption",
             self.paraphrases_per_caption,

@@ -243,10 +243,7 @@ fn with_controls(
     controls: &[Tensor<3>],
     input: &DenoiserInput,
 ) -> Tensor<3> {
-    let mut x = seq;
-    for (layer, add) in base.encoder().layers.iter().zip(controls) {
-        x = layer.forward(x, mask.clone(), None) + add.clone();
-    }
+    let x = base.layers(seq, mask, input, Some(controls));
     base.output(x, input)
 }
 

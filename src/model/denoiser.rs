@@ -6,6 +6,7 @@
 //! condition token dropped at the output.
 
 use super::config::{ModelConfig, TextEncoderKind};
+use super::moc::{MocConfig, TextControl, TextControlInput};
 use super::prompt::TextBatch;
 use super::text::{BagOfWords, TextEncoder};
 use burn::nn::transformer::{
@@ -51,6 +52,9 @@ pub struct Mdm {
     output_proj: Linear,
     /// Timestep sinusoid → per-feature gain on x_t added to the output (`input_skip`).
     skip: Option<Linear>,
+    /// OMG's text ControlNet ([`ModelConfig::text_control`]): when present, the text
+    /// enters only through it and the condition token reads the timestep alone.
+    text_control: Option<TextControl>,
     dropout: Dropout,
     d_model: usize,
     /// Frames the input skip reads around each frame ([`ModelConfig::skip_taps`]).
@@ -58,6 +62,28 @@ pub struct Mdm {
     /// Timestep from which only the centre tap reads ([`ModelConfig::skip_taps_below`];
     /// `usize::MAX`: every tap at every t).
     skip_taps_below: usize,
+}
+
+/// Makes every parameter a constant: its value detached and excluded from the gradients.
+/// With `no_grad` alone, a model loaded from a bundle failed in its second training step
+/// ("graph tape has already been consumed"; a fresh model did not), so the frozen values
+/// are cut from whatever built them.
+struct Frozen;
+
+impl burn::module::ModuleMapper for Frozen {
+    fn map_float<const D: usize>(
+        &mut self,
+        param: burn::module::Param<Tensor<D>>,
+    ) -> burn::module::Param<Tensor<D>> {
+        let id = param.id;
+        burn::module::Param::initialized(id, param.val().detach().set_require_grad(false))
+    }
+}
+
+impl Frozen {
+    fn map_module(&mut self, m: Linear) -> Linear {
+        m.map(self)
+    }
 }
 
 /// A `d → features` linear layer that starts at zero (weights and bias).
@@ -113,11 +139,68 @@ impl Mdm {
             skip: config
                 .input_skip
                 .then(|| zero_skip(d, config.features * config.skip_taps, device)),
+            text_control: None,
             dropout: DropoutConfig::new(config.dropout).init(),
             d_model: d,
             skip_taps: config.skip_taps,
             skip_taps_below: config.skip_taps_below.unwrap_or(usize::MAX),
         }
+        .with_text_control(config.text_control.as_ref(), device)
+    }
+
+    /// This denoiser with a fresh text ControlNet (its layer copies start as this model's
+    /// layers, its outputs at zero: it predicts the same), so an unconditional prior can
+    /// start OMG's second stage. Already there, or None asked: unchanged.
+    pub fn with_text_control(mut self, config: Option<&MocConfig>, device: &Device) -> Self {
+        if let (Some(c), None) = (config, &self.text_control) {
+            let d_text = self.text_proj.weight.dims()[0];
+            self.text_control = Some(TextControl::new(
+                &self.encoder.layers,
+                self.d_model,
+                d_text,
+                c,
+                device,
+            ));
+        }
+        self
+    }
+
+    /// Whether the text enters through a text ControlNet (the prompts' token states must
+    /// travel with them).
+    pub fn has_text_control(&self) -> bool {
+        self.text_control.is_some()
+    }
+
+    /// This denoiser with everything but its text ControlNet excluded from the gradients:
+    /// OMG's second stage trains the ControlNet on the frozen prior. Without one, the
+    /// whole model is frozen.
+    pub fn freeze_all_but_text_control(self) -> Self {
+        let frozen = |m| Frozen.map_module(m);
+        Mdm {
+            input_proj: frozen(self.input_proj),
+            time_1: frozen(self.time_1),
+            time_2: frozen(self.time_2),
+            text: self.text.map(|t| t.map(&mut Frozen)),
+            text_proj: frozen(self.text_proj),
+            side_proj: self.side_proj.map(frozen),
+            encoder: self.encoder.map(&mut Frozen),
+            output_proj: frozen(self.output_proj),
+            skip: self.skip.map(frozen),
+            ..self
+        }
+    }
+
+    /// The text ControlNet, if the model has one.
+    #[cfg(test)]
+    pub(crate) fn text_control(&self) -> Option<&TextControl> {
+        self.text_control.as_ref()
+    }
+
+    /// This model's text ControlNet randomised so that it steers (tests).
+    #[cfg(test)]
+    pub(crate) fn with_random_text_control(mut self, device: &Device) -> Self {
+        self.text_control = self.text_control.map(|c| c.randomised(device));
+        self
     }
 
     /// This denoiser with its input skip reading `taps` frames instead of one: the one-frame
@@ -211,6 +294,13 @@ impl Mdm {
         let t = sinusoids(input.timesteps.iter().copied(), self.d_model, device);
         let t = self.time_2.forward(silu(self.time_1.forward(t)));
         let keep = input.keep_text.clone().unsqueeze_dim::<2>(1);
+        // OMG: the prior was trained without text, so its condition token always reads the
+        // dropped text (the projection's bias); the text ControlNet carries the prompt.
+        let keep = if self.text_control.is_some() {
+            keep.zeros_like()
+        } else {
+            keep
+        };
         let (text, side) = match (&self.text, &input.text) {
             (Some(bag), TextBatch::Words(tokens)) => (bag.encode(tokens), None),
             (None, TextBatch::Sentences(s)) => (
@@ -251,6 +341,52 @@ impl Mdm {
     /// The encoder's layers (a ControlNet adds into the stream after each one).
     pub(crate) fn encoder(&self) -> &TransformerEncoder {
         &self.encoder
+    }
+
+    /// The encoder over the embedded `seq`, the text ControlNet's residual (if any) and
+    /// `controls` (a realism ControlNet's, one per layer, if any) added after each layer.
+    pub(crate) fn layers(
+        &self,
+        seq: Tensor<3>,
+        mask: Option<Tensor<2, Bool>>,
+        input: &DenoiserInput,
+        controls: Option<&[Tensor<3>]>,
+    ) -> Tensor<3> {
+        let text = self.text_control.as_ref().map(|c| {
+            let TextBatch::Sentences(s) = &input.text else {
+                unreachable!("a text ControlNet reads sentence batches")
+            };
+            let tokens = s
+                .tokens
+                .as_ref()
+                .expect("a model with a text ControlNet is given its prompts' token states");
+            (c, tokens, s.vectors.clone())
+        });
+        let mut x = seq;
+        for (l, layer) in self.encoder.layers.iter().enumerate() {
+            let out = layer.forward(x.clone(), mask.clone(), None);
+            let out = match &text {
+                Some((c, tokens, sentences)) => {
+                    let residual = c.residual(
+                        l,
+                        x,
+                        &TextControlInput {
+                            tokens: &tokens.own,
+                            sentences,
+                            keep: &input.keep_text,
+                            padding: mask.as_ref(),
+                        },
+                    );
+                    out + residual
+                }
+                None => out,
+            };
+            x = match controls {
+                Some(c) => out + c[l].clone(),
+                None => out,
+            };
+        }
+        x
     }
 
     /// x̂0 `[B, N, F]` from the encoder's output `[B, N+1, d]`.
@@ -331,6 +467,10 @@ impl Mdm {
 impl Denoiser for Mdm {
     fn predict_x0(&self, input: &DenoiserInput) -> Tensor<3> {
         let (seq, mask) = self.embed(input);
+        if self.text_control.is_some() {
+            let out = self.layers(seq, mask, input, None);
+            return self.output(out, input);
+        }
         let mut enc_in = TransformerEncoderInput::new(seq);
         if let Some(mask) = mask {
             enc_in = enc_in.mask_pad(mask);
@@ -489,6 +629,7 @@ mod tests {
             text: TextBatch::Sentences(SentenceBatch {
                 vectors: vec(v),
                 mirrored: vec(m),
+                tokens: None,
             }),
             keep_text: Tensor::full([1], keep, dev),
             padding: None,

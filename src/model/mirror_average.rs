@@ -96,6 +96,10 @@ impl<D: Denoiser> Denoiser for MirrorAveraged<D> {
                 TextBatch::Sentences(s) => TextBatch::Sentences(SentenceBatch {
                     vectors: Tensor::cat(vec![s.vectors.clone(), s.mirrored.clone()], 0),
                     mirrored: Tensor::cat(vec![s.mirrored.clone(), s.vectors.clone()], 0),
+                    tokens: s
+                        .tokens
+                        .clone()
+                        .map(|t| Box::new(t.clone().concat(t.swapped()))),
                 }),
             },
             keep_text: Tensor::cat(vec![input.keep_text.clone(), input.keep_text.clone()], 0),
@@ -182,6 +186,7 @@ mod tests {
             skip_taps: 1,
             skip_taps_below: None,
             side_input: false,
+            text_control: None,
         };
         let net = Mdm::new(&cfg, vocab().len(), &dev).valid();
         let (mean, std) = stats();

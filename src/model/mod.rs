@@ -11,6 +11,7 @@ pub mod ema;
 pub mod generate;
 pub mod lengths;
 pub mod mirror_average;
+pub mod moc;
 pub mod noise;
 pub mod prompt;
 pub mod sampler;

@@ -4,7 +4,9 @@
 //! tell the user about a prompt); [`TextBatch`] is what travels in a `DenoiserInput`.
 
 use super::lengths::CaptionLengths;
-use super::sentence::{CaptionIndex, FAR_COSINE, Nearest, SNAP_COSINE, SentenceEncoder, Snapped};
+use super::sentence::{
+    CaptionIndex, FAR_COSINE, Nearest, SNAP_COSINE, SentenceEncoder, Snapped, TokenStates,
+};
 use super::text::{TokenBatch, Vocabulary};
 use burn::prelude::*;
 use std::sync::Arc;
@@ -44,6 +46,48 @@ pub struct SentenceBatch {
     pub vectors: Tensor<2>,
     /// `[B, D]` vectors of the prompts with left and right swapped (for mirror averaging).
     pub mirrored: Tensor<2>,
+    /// The prompts' token states, for a model with a text ControlNet (`model::moc`); None
+    /// for a model that reads the vectors alone.
+    pub tokens: Option<Box<PromptTokens>>,
+}
+
+/// Token states of a batch of prompts and of their side-swapped versions.
+#[derive(Clone, Debug)]
+pub struct PromptTokens {
+    /// The prompts as written.
+    pub own: TokenStates,
+    /// The prompts with left and right swapped (for mirror averaging).
+    pub mirrored: TokenStates,
+}
+
+impl PromptTokens {
+    /// `self` then `other`, along the batch.
+    pub fn concat(self, other: PromptTokens) -> PromptTokens {
+        PromptTokens {
+            own: self.own.concat(other.own),
+            mirrored: self.mirrored.concat(other.mirrored),
+        }
+    }
+
+    /// The same batch with each prompt's sides swapped.
+    pub fn swapped(self) -> PromptTokens {
+        PromptTokens {
+            own: self.mirrored,
+            mirrored: self.own,
+        }
+    }
+}
+
+/// Both optional token batches concatenated; a model reads tokens for every sample or none.
+fn concat_tokens(
+    a: Option<Box<PromptTokens>>,
+    b: Option<Box<PromptTokens>>,
+) -> Option<Box<PromptTokens>> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(Box::new(a.concat(*b))),
+        (None, None) => None,
+        _ => unreachable!("one prompt encoder builds every text batch of a run"),
+    }
 }
 
 /// The text condition of a batch, in the form the model's encoder reads.
@@ -76,6 +120,7 @@ impl TextBatch {
                 TextBatch::Sentences(SentenceBatch {
                     vectors: Tensor::cat(vec![a.vectors, b.vectors], 0),
                     mirrored: Tensor::cat(vec![a.mirrored, b.mirrored], 0),
+                    tokens: concat_tokens(a.tokens, b.tokens),
                 })
             }
             _ => unreachable!("one prompt encoder builds every text batch of a run"),
@@ -118,6 +163,10 @@ pub struct SentencePrompts {
     /// A prompt whose best cosine with a caption is below this is conditioned on its
     /// neighbours instead ([`CaptionIndex::snap`]); 0 reads every prompt as written.
     pub snap_below: f32,
+    /// Whether the model reads the prompts' token states too (a text ControlNet,
+    /// `model::moc`). Tokens are never snapped: reading unseen wordings token by token is
+    /// what OMG's design is for.
+    pub tokens: bool,
 }
 
 impl SentencePrompts {
@@ -132,6 +181,42 @@ impl SentencePrompts {
             captions,
             lengths,
             snap_below: SNAP_COSINE,
+            tokens: false,
+        }
+    }
+
+    /// The token states of `prompts` and of their side-swapped versions, on `device`.
+    pub fn tokens_of(&self, prompts: &[&str], device: &Device) -> PromptTokens {
+        let swapped: Vec<String> = prompts.iter().map(|p| swap_side_words(p)).collect();
+        // Each distinct sentence once (most prompts name no side, and a batch repeats).
+        let mut distinct: Vec<&str> = Vec::new();
+        let rows: Vec<i64> = prompts
+            .iter()
+            .copied()
+            .chain(swapped.iter().map(String::as_str))
+            .map(|s| {
+                let at = distinct.iter().position(|d| *d == s);
+                at.unwrap_or_else(|| {
+                    distinct.push(s);
+                    distinct.len() - 1
+                }) as i64
+            })
+            .collect();
+        let states = self.encoder.encode_tokens(&distinct).to_device(device);
+        let b = prompts.len();
+        let pick = |from: usize| {
+            let ids = Tensor::<1, Int>::from_data(
+                TensorData::new(rows[from..from + b].to_vec(), [b]),
+                device,
+            );
+            TokenStates {
+                states: states.states.clone().select(0, ids.clone()),
+                mask: states.mask.clone().select(0, ids),
+            }
+        };
+        PromptTokens {
+            own: pick(0),
+            mirrored: pick(b),
         }
     }
 }
@@ -170,6 +255,7 @@ impl PromptEncoder {
                 TextBatch::Sentences(SentenceBatch {
                     vectors: both.clone().narrow(0, 0, b),
                     mirrored: both.narrow(0, b, b),
+                    tokens: s.tokens.then(|| Box::new(s.tokens_of(prompts, device))),
                 })
             }
         }

@@ -316,3 +316,81 @@ fn an_augmented_run_keeps_near_paraphrases_and_never_a_held_out_one() {
     let again = CaptionAugment::load_table(&out.path().join("paraphrases.json")).unwrap();
     assert_eq!(table, again);
 }
+
+#[test]
+fn an_unconditional_bundle_starts_the_text_controlnet_and_only_it_learns() {
+    use super::denoiser::{Denoiser, DenoiserInput};
+    use super::moc::MocConfig;
+    use super::noise::NoiseSource;
+    let dev = Device::flex();
+    let prior_dir = tempfile::tempdir().unwrap();
+    let prior_config = ModelConfig {
+        side_input: true,
+        input_skip: true,
+        skip_taps: 3,
+        skip_taps_below: Some(100),
+        ..sentence_tiny()
+    };
+    train(prior_dir.path(), prior_config, None, 1e-3, 5);
+    let prior = ModelBundle::load(&prior_dir.path().join("bundle"), &dev).unwrap();
+    let run = tempfile::tempdir().unwrap();
+    let omg = ModelConfig {
+        side_input: true,
+        input_skip: true,
+        skip_taps: 3,
+        skip_taps_below: Some(100),
+        text_control: Some(MocConfig {
+            d_control: 8,
+            experts: 3,
+            ..MocConfig::default()
+        }),
+        ..sentence_tiny()
+    };
+    train(
+        run.path(),
+        omg,
+        Some(&prior_dir.path().join("bundle")),
+        1e-2,
+        5,
+    );
+    let bundle = ModelBundle::load(&run.path().join("bundle"), &dev).unwrap();
+    assert!(bundle.model.has_text_control());
+    let (old, new) = (tensors(&prior.model), tensors(&bundle.model));
+    for (name, value) in &new {
+        if name.starts_with("text_control") {
+            continue;
+        }
+        let diff = old[name]
+            .iter()
+            .zip(value)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(diff < 2e-3, "the frozen prior's {name} moved by {diff}");
+    }
+    let ups: f32 = new
+        .iter()
+        .filter(|(k, _)| k.starts_with("text_control.blocks") && k.contains(".up."))
+        .flat_map(|(_, v)| v.iter().map(|x| x.abs()))
+        .sum();
+    assert!(ups > 0.0, "the ControlNet's zero outputs learnt");
+    // The bundle reads its prompts token by token, and the text steers only where kept.
+    let text = bundle
+        .text
+        .batch(&["a person waves", "a person walks forward"], &dev);
+    let super::prompt::TextBatch::Sentences(s) = &text else {
+        panic!("sentence batch")
+    };
+    assert!(s.tokens.is_some());
+    let model = bundle.model.clone();
+    let ask = |keep: f32| {
+        model.predict_x0(&DenoiserInput {
+            x_t: NoiseSource::new(3).tensor([2, 8, 263], &dev),
+            timesteps: vec![500, 500],
+            text: text.clone(),
+            keep_text: Tensor::full([2], keep, &dev),
+            padding: None,
+        })
+    };
+    let moved = (ask(1.0) - ask(0.0)).abs().max().into_scalar::<f32>();
+    assert!(moved > 0.0);
+}

@@ -28,6 +28,7 @@ pub(super) fn tiny() -> ModelConfig {
         skip_taps: 1,
         skip_taps_below: None,
         side_input: false,
+        text_control: None,
     }
 }
 

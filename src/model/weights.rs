@@ -361,11 +361,13 @@ fn load_prompt_encoder(
     let captions_path = dir.join("captions.safetensors");
     let captions = CaptionIndex::load(&captions_path, device)
         .map_err(|e| mismatch(&captions_path, e.to_string()))?;
-    Ok(PromptEncoder::Sentences(Box::new(SentencePrompts::new(
+    let mut prompts = SentencePrompts::new(
         std::sync::Arc::new(encoder),
         captions,
         CaptionLengths::load(dir)?,
-    ))))
+    );
+    prompts.tokens = config.text_control.is_some();
+    Ok(PromptEncoder::Sentences(Box::new(prompts)))
 }
 
 /// The sentence encoder folder for a bundle: `<dir>/text-encoder`, `<dir>/../text-encoder`,

@@ -68,6 +68,7 @@ pub(super) fn tiny_bundle() -> ModelBundle {
         skip_taps: 1,
         skip_taps_below: None,
         side_input: false,
+        text_control: None,
     };
     let vocab = Vocabulary::from_captions(["a person walks forward", "a person waves"], 8);
     let model =

@@ -127,8 +127,20 @@ impl Bert {
     }
 
     /// Sentence vectors `[B, hidden]`, L2-normalised, for padded ids `[B, L]` and a mask
-    /// `[B, L]` (1 for tokens, 0 for padding).
+    /// `[B, L]` (1 for tokens, 0 for padding): the mean of [`Bert::hidden_states`] over
+    /// the tokens.
     pub fn embed(&self, ids: Tensor<2, Int>, mask: Tensor<2>) -> Tensor<2> {
+        let x = self.hidden_states(ids, mask.clone());
+        let mask = mask.unsqueeze_dim::<3>(2);
+        let counts = mask.clone().sum_dim(1).clamp_min(1.0);
+        let pooled = (x * mask).sum_dim(1).div(counts).squeeze_dim::<2>(1);
+        let norm = pooled.clone().square().sum_dim(1).sqrt().clamp_min(1e-12);
+        pooled.div(norm)
+    }
+
+    /// The last layer's token states `[B, L, hidden]` for padded ids `[B, L]` and a mask
+    /// `[B, L]` (rows of padding are not meaningful).
+    pub fn hidden_states(&self, ids: Tensor<2, Int>, mask: Tensor<2>) -> Tensor<3> {
         let [_, len] = ids.dims();
         let position = self.position.weight.val().slice(0..len).unsqueeze_dim(0);
         let segment = self.token_type.weight.val().slice(0..1).unsqueeze_dim(0);
@@ -145,10 +157,6 @@ impl Bert {
                 .forward(gelu(layer.intermediate.forward(x.clone())));
             x = layer.output_norm.forward(x + hidden);
         }
-        let mask = mask.unsqueeze_dim::<3>(2);
-        let counts = mask.clone().sum_dim(1).clamp_min(1.0);
-        let pooled = (x * mask).sum_dim(1).div(counts).squeeze_dim::<2>(1);
-        let norm = pooled.clone().square().sum_dim(1).sqrt().clamp_min(1e-12);
-        pooled.div(norm)
+        x
     }
 }

@@ -26,6 +26,55 @@ use std::path::{Path, PathBuf};
 /// Sentences per forward pass: bounds padding waste and the attention tensors' size.
 const CHUNK: usize = 64;
 
+/// Most tokens of a sentence whose states a model reads ([`SentenceEncoder::encode_tokens`]):
+/// captions run to about 20; a long prompt is cut (its `[SEP]` kept).
+pub const MAX_STATE_TOKENS: usize = 48;
+
+/// The token states of a batch of sentences.
+#[derive(Clone, Debug)]
+pub struct TokenStates {
+    /// `[B, L, D]` last-layer states.
+    pub states: Tensor<3>,
+    /// `[B, L]` 1 on tokens, 0 on padding.
+    pub mask: Tensor<2>,
+}
+
+impl TokenStates {
+    /// `self` then `other` along the batch, the shorter padded with mask 0.
+    pub fn concat(self, other: TokenStates) -> TokenStates {
+        let len = self.mask.dims()[1].max(other.mask.dims()[1]);
+        let (a, b) = (self.padded(len), other.padded(len));
+        TokenStates {
+            states: Tensor::cat(vec![a.states, b.states], 0),
+            mask: Tensor::cat(vec![a.mask, b.mask], 0),
+        }
+    }
+
+    /// These states padded to `len` tokens.
+    fn padded(self, len: usize) -> TokenStates {
+        let [b, l, d] = self.states.dims();
+        if l >= len {
+            return self;
+        }
+        let device = self.states.device();
+        TokenStates {
+            states: Tensor::cat(
+                vec![self.states, Tensor::zeros([b, len - l, d], &device)],
+                1,
+            ),
+            mask: Tensor::cat(vec![self.mask, Tensor::zeros([b, len - l], &device)], 1),
+        }
+    }
+
+    /// The same states on `device`.
+    pub fn to_device(self, device: &Device) -> TokenStates {
+        TokenStates {
+            states: self.states.to_device(device),
+            mask: self.mask.to_device(device),
+        }
+    }
+}
+
 /// Why the encoder's files could not be used.
 #[derive(Debug, thiserror::Error)]
 pub enum SentenceError {
@@ -190,6 +239,47 @@ impl SentenceEncoder {
         let sorted = Tensor::cat(parts, 0);
         let rows = Tensor::<1, Int>::from_data(TensorData::new(rows, [ids.len()]), &self.device);
         sorted.select(0, rows)
+    }
+
+    /// Token states of each sentence for a model that reads them one by one (OMG's text
+    /// ControlNet, `model::moc`): the last layer's `[B, L, 384]` states, `[CLS]` and
+    /// `[SEP]` included, at most [`MAX_STATE_TOKENS`] per sentence, padded to the longest
+    /// with mask 0.
+    pub fn encode_tokens(&self, sentences: &[&str]) -> TokenStates {
+        let ids: Vec<Vec<u32>> = sentences
+            .iter()
+            .map(|s| {
+                let mut t = self.tokenizer.encode(s);
+                if t.len() > MAX_STATE_TOKENS {
+                    let sep = t[t.len() - 1];
+                    t.truncate(MAX_STATE_TOKENS - 1);
+                    t.push(sep);
+                }
+                t
+            })
+            .collect();
+        let b = ids.len();
+        let len = ids.iter().map(Vec::len).max().unwrap_or(0).max(1);
+        let mut flat = vec![0i64; b * len];
+        let mut mask = vec![0f32; b * len];
+        for (r, seq) in ids.iter().enumerate() {
+            for (k, &id) in seq.iter().enumerate() {
+                flat[r * len + k] = i64::from(id);
+                mask[r * len + k] = 1.0;
+            }
+        }
+        if b == 0 {
+            return TokenStates {
+                states: Tensor::zeros([0, len, self.dim()], &self.device),
+                mask: Tensor::zeros([0, len], &self.device),
+            };
+        }
+        let ids = Tensor::<2, Int>::from_data(TensorData::new(flat, [b, len]), &self.device);
+        let mask = Tensor::<2>::from_data(TensorData::new(mask, [b, len]), &self.device);
+        TokenStates {
+            states: self.bert.hidden_states(ids, mask.clone()),
+            mask,
+        }
     }
 
     fn encode_chunk<'a>(&self, ids: impl Iterator<Item = &'a [u32]> + Clone) -> Tensor<2> {

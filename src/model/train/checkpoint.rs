@@ -72,6 +72,13 @@ impl TrainRun<'_> {
                     skip_taps_below: cfg.model.skip_taps_below,
                     // Dropout has no weights either: a fine-tune may change it.
                     dropout: cfg.model.dropout,
+                    // An unconditional prior may start OMG's second stage (its text
+                    // ControlNet added at zero).
+                    text_control: bundle
+                        .config
+                        .text_control
+                        .clone()
+                        .or_else(|| cfg.model.text_control.clone()),
                     ..bundle.config.clone()
                 };
                 let weights = init.join("model.safetensors");
@@ -128,6 +135,16 @@ impl TrainRun<'_> {
                     model = model.with_skip_taps(taps);
                     ema = ema.with_skip_taps(taps);
                 }
+                let (model, ema) = match &cfg.model.text_control {
+                    // A fresh text ControlNet: the EMA starts as the very same one.
+                    Some(_) if !model.has_text_control() => {
+                        let model =
+                            model.with_text_control(cfg.model.text_control.as_ref(), train_dev);
+                        let ema = model.valid().to_device(plain);
+                        (model, ema)
+                    }
+                    _ => (model, ema),
+                };
                 let below = cfg.model.skip_taps_below;
                 let (model, ema) = (
                     model.with_skip_taps_below(below),

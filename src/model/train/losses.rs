@@ -38,7 +38,22 @@ pub(crate) fn to_device(
         TextBatch::Sentences(s) if batch.text_noise > 0.0 => {
             let (vectors, mirrored) =
                 noisy_vectors(s.vectors, s.mirrored, batch.text_noise, batch.noise_seed);
-            TextBatch::Sentences(SentenceBatch { vectors, mirrored })
+            TextBatch::Sentences(SentenceBatch {
+                vectors,
+                mirrored,
+                tokens: s.tokens,
+            })
+        }
+        other => other,
+    };
+    let text = match text {
+        TextBatch::Sentences(s) if !batch.eos_keep.is_empty() => {
+            let keep =
+                Tensor::<2>::from_data(TensorData::new(batch.eos_keep.clone(), [b, 1]), device);
+            TextBatch::Sentences(SentenceBatch {
+                vectors: s.vectors * keep,
+                ..s
+            })
         }
         other => other,
     };

@@ -218,6 +218,10 @@ impl TrainRun<'_> {
         let device = plain.clone().autodiff();
         let schedule = NoiseSchedule::cosine(DIFFUSION_STEPS);
         let mut ck = self.load_or_init(&text, &device, &plain)?;
+        if cfg.model.text_control.is_some() {
+            // OMG's second stage: only the text ControlNet learns.
+            ck.model = ck.model.freeze_all_but_text_control();
+        }
         let teacher = self.teacher(&plain)?;
         let geometric = GeometricLosses::new(cfg, &self.data.mean, &self.data.std, &device);
         let stop_at = match self.max_steps_now {

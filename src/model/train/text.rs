@@ -136,6 +136,9 @@ impl TrainText {
                 TextBatch::Sentences(SentenceBatch {
                     vectors: both.clone().narrow(0, 0, b),
                     mirrored: both.narrow(0, b, b),
+                    tokens: prompts
+                        .tokens
+                        .then(|| Box::new(prompts.tokens_of(captions, device))),
                 })
             }
         }
@@ -186,11 +189,16 @@ impl TrainRun<'_> {
                 index
             }
         };
-        Ok(TrainText::sentences(
+        let mut text = TrainText::sentences(
             Arc::new(encoder),
             index,
             CaptionLengths::of_dataset(self.data),
-        ))
+        );
+        if let TrainText::Sentences { prompts, .. } = &mut text {
+            // A text ControlNet reads each caption's token states, encoded per batch.
+            prompts.tokens = self.config.model.text_control.is_some();
+        }
+        Ok(text)
     }
 
     /// The run's vocabulary: read back when resuming, else built from the captions and saved.
