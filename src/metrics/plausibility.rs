@@ -795,6 +795,12 @@ fn facing_check(m: &Motion, out: &mut Vec<Problem>) {
 
 /// Closest distance between segments [p1, q1] and [p2, q2].
 pub fn segment_distance(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) -> f32 {
+    let (s, t) = segment_closest(p1, q1, p2, q2);
+    ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).length()
+}
+
+/// Where segments [p1, q1] and [p2, q2] come closest: the fractions `(s, t)` along each.
+pub fn segment_closest(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) -> (f32, f32) {
     let d1 = q1 - p1;
     let d2 = q2 - p2;
     let r = p1 - p2;
@@ -802,7 +808,7 @@ pub fn segment_distance(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) -> f32 {
     let e = d2.dot(d2);
     let f = d2.dot(r);
     let eps = 1e-9;
-    let (s, t) = if a <= eps && e <= eps {
+    if a <= eps && e <= eps {
         (0.0, 0.0)
     } else if a <= eps {
         (0.0, (f / e).clamp(0.0, 1.0))
@@ -828,8 +834,7 @@ pub fn segment_distance(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) -> f32 {
             }
             (s, t)
         }
-    };
-    ((p1 + d1 * s) - (p2 + d2 * t)).length()
+    }
 }
 
 fn overlap_check(a: &Motion, b: &Motion, pa: usize, pb: usize, out: &mut Vec<Problem>) {

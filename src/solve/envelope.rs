@@ -13,6 +13,9 @@
 //!   at most [`TORSO_ACCEL_LIMIT`];
 //! * **floor**: any joint below `y = 0`;
 //! * **twist**: the shoulder girdle turned on the hips further than [`MIN_TWIST_COS`];
+//! * **people apart**: two people's body capsules (the report's
+//!   [`crate::metrics::plausibility::CAPSULES`]) overlapping by more than [`APART_SLACK`]:
+//!   a kick met its contact with the kicker's thigh through the other's arm;
 //! * **folding**: the torso curled or the shoulders folded in further than any recorded
 //!   frame ([`MIN_SPANS`]): the late steps met "hand on the head" by hunching the spine to
 //!   0.59 of its length and folding the shoulders to 0.17 m apart, where the training data
@@ -77,6 +80,11 @@ pub const MIN_SPANS: [(usize, usize, f32); 5] = [
     (2, 9, 0.307),
     (16, 17, 0.27),
 ];
+
+/// Overlap (m) of two people's capsules the late steps allow: a third of what the report
+/// flags ([`crate::metrics::plausibility::OVERLAP_DEPTH`]), so a contact met with the
+/// bodies close keeps them short of the report's line.
+pub const APART_SLACK: f32 = 0.01;
 
 /// Smallest cosine of the angle between the hip line and the collar line (60°): the
 /// training data twists the torso that far on 0.01 % of its frames (59°; 40° at the
@@ -202,8 +210,72 @@ impl EnvelopeGuard {
                 }
             }
         }
+        for (sample, p) in penalty.iter_mut().enumerate() {
+            for a in 0..self.people {
+                for b in a + 1..self.people {
+                    let (ma, mb) = (sample * self.people + a, sample * self.people + b);
+                    let (lo, hi) = grad.split_at_mut(mb * per);
+                    *p += apart(
+                        [
+                            &joints[ma * per..(ma + 1) * per],
+                            &joints[mb * per..(mb + 1) * per],
+                        ],
+                        [&mut lo[ma * per..(ma + 1) * per], &mut hi[..per]],
+                        self.frames,
+                        floor_scale,
+                    );
+                }
+            }
+        }
         penalty
     }
+}
+
+/// The people-apart term of two people's joints `[N, 22, 3]` (scaled by `scale` per
+/// frame), its gradient added to theirs. The distance between two capsules' closest points
+/// moves with their endpoints as the closest points' weights say (the fractions along
+/// each segment are a minimum, so their own change adds nothing to first order).
+fn apart(people: [&[f32]; 2], grads: [&mut [f32]; 2], frames: usize, scale: f32) -> f32 {
+    use crate::metrics::plausibility::{CAPSULES, segment_closest};
+    let [a, b] = people;
+    let [ga, gb] = grads;
+    let at = |m: &[f32], t: usize, j: usize| {
+        let k = t * J3 + 3 * j;
+        glam::Vec3::new(m[k], m[k + 1], m[k + 2])
+    };
+    let mut total = 0.0;
+    for t in 0..frames {
+        for ca in &CAPSULES {
+            for cb in &CAPSULES {
+                let [a0, a1] = ca.joints.map(|j| at(a, t, j));
+                let [b0, b1] = cb.joints.map(|j| at(b, t, j));
+                let (s, u) = segment_closest(a0, a1, b0, b1);
+                let r = (a0 + (a1 - a0) * s) - (b0 + (b1 - b0) * u);
+                let dist = r.length();
+                let (v, d) = hinge(ca.radius + cb.radius - APART_SLACK - dist);
+                if v == 0.0 && d == 0.0 {
+                    continue;
+                }
+                total += scale * v;
+                // d/dp of s(R − |r|) = −s' · r̂ · ∂r/∂p; descent moves the closest points
+                // apart along r̂.
+                let n = r / dist.max(1e-6) * (scale * d);
+                for (j, w) in [(ca.joints[0], 1.0 - s), (ca.joints[1], s)] {
+                    let k = t * J3 + 3 * j;
+                    for i in 0..3 {
+                        ga[k + i] -= w * n[i];
+                    }
+                }
+                for (j, w) in [(cb.joints[0], 1.0 - u), (cb.joints[1], u)] {
+                    let k = t * J3 + 3 * j;
+                    for i in 0..3 {
+                        gb[k + i] += w * n[i];
+                    }
+                }
+            }
+        }
+    }
+    total
 }
 
 #[cfg(test)]
@@ -302,16 +374,46 @@ mod tests {
     }
 
     #[test]
+    fn two_people_through_each_other_cost_and_are_pushed_apart() {
+        let frames = 3;
+        let guard = EnvelopeGuard::new(frames, 2, 1.0);
+        let a = motion(|_| 0.0, frames);
+        // The second person 1 m to the side: free; 10 cm to the side: torsos overlap.
+        let far = [a.clone(), motion(|_| 1.0, frames)].concat();
+        let mut g = vec![0.0; far.len()];
+        assert_eq!(guard.eval(&far, &mut g), vec![0.0]);
+        let near = [a, motion(|_| 0.15, frames)].concat();
+        let mut g = vec![0.0; near.len()];
+        assert!(guard.eval(&near, &mut g)[0] > 0.0);
+        // Descent moves the first person to −x and the second to +x (summed over joints:
+        // a hip may be pushed across the other's).
+        let x_pull = |person: usize| -> f32 {
+            let per = frames * J3;
+            (0..per).step_by(3).map(|k| g[person * per + k]).sum()
+        };
+        assert!(
+            x_pull(0) > 0.0 && x_pull(1) < 0.0,
+            "{} {}",
+            x_pull(0),
+            x_pull(1)
+        );
+    }
+
+    #[test]
     fn gradient_matches_finite_differences() {
         let frames = 7;
         let guard = EnvelopeGuard::new(frames, 2, 0.7);
         let mut x: Vec<f32> = (0..2 * frames * J3)
             .map(|i| 0.3 * (0.71 * i as f32).sin())
             .collect();
-        // Some joints below the floor, some fast.
+        // Some joints below the floor, some fast; the second person a little aside, so
+        // no two of the people's segments cross exactly (where the distance has a kink).
         for (i, v) in x.iter_mut().enumerate() {
             if i % 3 == 1 {
                 *v += 0.2;
+            }
+            if i >= frames * J3 && i % 3 == 2 {
+                *v += 0.05;
             }
         }
         let mut g = vec![0.0; x.len()];
