@@ -5,6 +5,8 @@
 //! Conventions (the whole crate follows them): metres, Y up, the person's forward is +Z
 //! at frame 0 of a canonicalised clip, their left is +X, 20 frames per second.
 
+pub mod capsules;
+
 use glam::Vec3;
 
 /// Number of joints in the HumanML3D skeleton.

@@ -14,7 +14,7 @@
 //! * **floor**: any joint below `y = 0`;
 //! * **twist**: the shoulder girdle turned on the hips further than [`MIN_TWIST_COS`];
 //! * **people apart**: two people's body capsules (the report's
-//!   [`crate::metrics::plausibility::CAPSULES`]) overlapping by more than [`APART_SLACK`]:
+//!   [`crate::skeleton::capsules::CAPSULES`]) overlapping by more than [`APART_SLACK`]:
 //!   a kick met its contact with the kicker's thigh through the other's arm;
 //! * **folding**: the torso curled or the shoulders folded in further than any recorded
 //!   frame ([`MIN_SPANS`]): the late steps met "hand on the head" by hunching the spine to
@@ -236,7 +236,7 @@ impl EnvelopeGuard {
 /// moves with their endpoints as the closest points' weights say (the fractions along
 /// each segment are a minimum, so their own change adds nothing to first order).
 fn apart(people: [&[f32]; 2], grads: [&mut [f32]; 2], frames: usize, scale: f32) -> f32 {
-    use crate::metrics::plausibility::{CAPSULES, segment_closest};
+    use crate::skeleton::capsules::{CAPSULES, segment_closest};
     let [a, b] = people;
     let [ga, gb] = grads;
     let at = |m: &[f32], t: usize, j: usize| {
