@@ -65,8 +65,33 @@ pub fn backend_name() -> String {
         .unwrap_or_else(|| "flex".into())
 }
 
-/// One line about this machine: CPU model and logical cores, plus the GPU's name when
-/// `nvidia-smi` answers (best effort; for benchmark headers).
+/// The widest vector instructions this CPU offers that the matrix kernels use: gemm picks
+/// its AVX-512 kernels at run time where the CPU has them (the `x86-v4` feature it is
+/// built with), else AVX2 with FMA.
+pub fn vector_width() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            return "AVX-512";
+        }
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        {
+            return "AVX2";
+        }
+        "SSE"
+    }
+    #[cfg(target_arch = "aarch64")]
+    {
+        "NEON"
+    }
+    #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
+    {
+        "scalar"
+    }
+}
+
+/// One line about this machine: CPU model, its vector width and logical cores, plus the
+/// GPU's name when `nvidia-smi` answers (best effort; for benchmark headers).
 pub fn machine_description() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -85,9 +110,10 @@ pub fn machine_description() -> String {
         .filter(|o| o.status.success())
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
         .filter(|s| !s.is_empty());
+    let width = vector_width();
     match gpu {
-        Some(g) => format!("{cpu}, {cores} cores; GPU {g}"),
-        None => format!("{cpu}, {cores} cores"),
+        Some(g) => format!("{cpu} ({width}), {cores} cores; GPU {g}"),
+        None => format!("{cpu} ({width}), {cores} cores"),
     }
 }
 
