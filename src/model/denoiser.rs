@@ -80,10 +80,9 @@ impl burn::module::ModuleMapper for Frozen {
     }
 }
 
-impl Frozen {
-    fn map_module(&mut self, m: Linear) -> Linear {
-        m.map(self)
-    }
+/// `module` with every parameter a constant ([`Frozen`]).
+fn frozen<M: Module>(module: M) -> M {
+    module.map(&mut Frozen)
 }
 
 /// A `d → features` linear layer that starts at zero (weights and bias).
@@ -175,15 +174,14 @@ impl Mdm {
     /// OMG's second stage trains the ControlNet on the frozen prior. Without one, the
     /// whole model is frozen.
     pub fn freeze_all_but_text_control(self) -> Self {
-        let frozen = |m| Frozen.map_module(m);
         Mdm {
             input_proj: frozen(self.input_proj),
             time_1: frozen(self.time_1),
             time_2: frozen(self.time_2),
-            text: self.text.map(|t| t.map(&mut Frozen)),
+            text: self.text.map(frozen),
             text_proj: frozen(self.text_proj),
             side_proj: self.side_proj.map(frozen),
-            encoder: self.encoder.map(&mut Frozen),
+            encoder: frozen(self.encoder),
             output_proj: frozen(self.output_proj),
             skip: self.skip.map(frozen),
             ..self
