@@ -9,9 +9,7 @@ use super::config::{ModelConfig, TextEncoderKind};
 use super::moc::{MocConfig, TextControl, TextControlInput};
 use super::prompt::TextBatch;
 use super::text::{BagOfWords, TextEncoder};
-use burn::nn::transformer::{
-    TransformerEncoder, TransformerEncoderConfig, TransformerEncoderInput,
-};
+use burn::nn::transformer::{TransformerEncoder, TransformerEncoderConfig};
 use burn::nn::{Dropout, DropoutConfig, Linear, LinearConfig};
 use burn::prelude::*;
 use burn::tensor::activation::silu;
@@ -465,15 +463,7 @@ impl Mdm {
 impl Denoiser for Mdm {
     fn predict_x0(&self, input: &DenoiserInput) -> Tensor<3> {
         let (seq, mask) = self.embed(input);
-        if self.text_control.is_some() {
-            let out = self.layers(seq, mask, input, None);
-            return self.output(out, input);
-        }
-        let mut enc_in = TransformerEncoderInput::new(seq);
-        if let Some(mask) = mask {
-            enc_in = enc_in.mask_pad(mask);
-        }
-        let out = self.encoder.forward(enc_in); // [B, N+1, d]
+        let out = self.layers(seq, mask, input, None); // [B, N+1, d]
         self.output(out, input)
     }
 }

@@ -210,18 +210,7 @@ impl SentenceEncoder {
     /// L2-normalised sentence vectors `[B, 384]`, in the order of `sentences`.
     pub fn encode(&self, sentences: &[&str]) -> Tensor<2> {
         let max = MAX_TOKENS.min(self.bert.max_positions());
-        let ids: Vec<Vec<u32>> = sentences
-            .iter()
-            .map(|s| {
-                let mut t = self.tokenizer.encode(s);
-                if t.len() > max {
-                    let sep = t[t.len() - 1];
-                    t.truncate(max - 1);
-                    t.push(sep);
-                }
-                t
-            })
-            .collect();
+        let ids: Vec<Vec<u32>> = sentences.iter().map(|s| self.ids(s, max)).collect();
         // Similar lengths share a chunk, so little is padded.
         let mut order: Vec<usize> = (0..ids.len()).collect();
         order.sort_by_key(|&i| ids[i].len());
@@ -248,41 +237,37 @@ impl SentenceEncoder {
     pub fn encode_tokens(&self, sentences: &[&str]) -> TokenStates {
         let ids: Vec<Vec<u32>> = sentences
             .iter()
-            .map(|s| {
-                let mut t = self.tokenizer.encode(s);
-                if t.len() > MAX_STATE_TOKENS {
-                    let sep = t[t.len() - 1];
-                    t.truncate(MAX_STATE_TOKENS - 1);
-                    t.push(sep);
-                }
-                t
-            })
+            .map(|s| self.ids(s, MAX_STATE_TOKENS))
             .collect();
-        let b = ids.len();
-        let len = ids.iter().map(Vec::len).max().unwrap_or(0).max(1);
-        let mut flat = vec![0i64; b * len];
-        let mut mask = vec![0f32; b * len];
-        for (r, seq) in ids.iter().enumerate() {
-            for (k, &id) in seq.iter().enumerate() {
-                flat[r * len + k] = i64::from(id);
-                mask[r * len + k] = 1.0;
-            }
-        }
-        if b == 0 {
+        if ids.is_empty() {
             return TokenStates {
-                states: Tensor::zeros([0, len, self.dim()], &self.device),
-                mask: Tensor::zeros([0, len], &self.device),
+                states: Tensor::zeros([0, 1, self.dim()], &self.device),
+                mask: Tensor::zeros([0, 1], &self.device),
             };
         }
-        let ids = Tensor::<2, Int>::from_data(TensorData::new(flat, [b, len]), &self.device);
-        let mask = Tensor::<2>::from_data(TensorData::new(mask, [b, len]), &self.device);
+        let (ids, mask) = self.padded(ids.iter().map(Vec::as_slice));
         TokenStates {
             states: self.bert.hidden_states(ids, mask.clone()),
             mask,
         }
     }
 
-    fn encode_chunk<'a>(&self, ids: impl Iterator<Item = &'a [u32]> + Clone) -> Tensor<2> {
+    /// `[CLS] pieces… [SEP]` of `sentence`, cut to `max` ids with its `[SEP]` kept.
+    fn ids(&self, sentence: &str, max: usize) -> Vec<u32> {
+        let mut t = self.tokenizer.encode(sentence);
+        if t.len() > max {
+            let sep = t[t.len() - 1];
+            t.truncate(max - 1);
+            t.push(sep);
+        }
+        t
+    }
+
+    /// Id sequences padded to the longest: ids `[B, L]` and mask `[B, L]` (1 on tokens).
+    fn padded<'a>(
+        &self,
+        ids: impl Iterator<Item = &'a [u32]> + Clone,
+    ) -> (Tensor<2, Int>, Tensor<2>) {
         let b = ids.clone().count();
         let len = ids.clone().map(<[u32]>::len).max().unwrap_or(0);
         let mut flat = vec![0i64; b * len];
@@ -295,6 +280,11 @@ impl SentenceEncoder {
         }
         let ids = Tensor::<2, Int>::from_data(TensorData::new(flat, [b, len]), &self.device);
         let mask = Tensor::<2>::from_data(TensorData::new(mask, [b, len]), &self.device);
+        (ids, mask)
+    }
+
+    fn encode_chunk<'a>(&self, ids: impl Iterator<Item = &'a [u32]> + Clone) -> Tensor<2> {
+        let (ids, mask) = self.padded(ids);
         self.bert.embed(ids, mask)
     }
 }
